@@ -1,0 +1,34 @@
+# Two entry points (see README): `make study` and `make test`.
+# Each creates .venv with the pinned dependencies of requirements.txt, no conda needed.
+PYTHON ?= python3
+VENV   ?= .venv
+CORES  ?= 2
+BIN     = $(VENV)/bin
+STAMP   = $(VENV)/.installed
+
+.PHONY: study test test-slow emps detection benchmark dag clean-results
+
+$(STAMP): requirements.txt pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install -q --disable-pip-version-check -r requirements.txt
+	$(BIN)/python -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation -e .
+	touch $@
+
+study: $(STAMP)
+	$(BIN)/snakemake --cores $(CORES) --printshellcmds all
+	$(BIN)/snakemake --cores $(CORES) all --report results/report.html
+
+test: $(STAMP)
+	$(BIN)/python -m pytest
+
+test-slow: $(STAMP)
+	$(BIN)/python -m pytest -m slow
+
+benchmark: $(STAMP)
+	$(BIN)/python benchmarks/bench_tmcmc.py
+
+dag: $(STAMP)
+	$(BIN)/snakemake -n all
+
+clean-results:
+	rm -rf results logs

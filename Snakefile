@@ -1,0 +1,24 @@
+# Reproduction of Green et al. (2015), "Probabilistic modelling of a rotational energy harvester",
+# on recordings from a SIMULATED virtual rig (the paper's recordings are not public).
+from snakemake.utils import min_version, validate
+
+min_version("9.0")
+
+configfile: "config/config.yaml"
+
+
+validate(config, "workflow/schemas/config.schema.yaml")
+
+report: "workflow/report/workflow.rst"
+
+
+include: "workflow/rules/common.smk"
+include: "workflow/rules/data.smk"
+include: "workflow/rules/preprocess.smk"
+include: "workflow/rules/initial.smk"
+include: "workflow/rules/identify.smk"
+
+
+rule all:
+    input:
+        all_outputs(),

@@ -1,0 +1,107 @@
+"""Zero-phase low-pass filter, PSD and H1 estimate (harvester.signals), Figures 4 and 5."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from harvester.errors import DataError
+from harvester.signals import filter_recording, filter_response_db, frf_h1, lowpass, psd
+
+CONFIG = yaml.safe_load((Path(__file__).parents[1] / "config" / "config.yaml").read_text())
+FS = float(CONFIG["rig"]["daq"]["sampling_rate_hz"])
+CUTOFF = float(CONFIG["preprocess"]["lowpass_hz"])
+ORDER = int(CONFIG["preprocess"]["filter_order"])
+
+
+def tone_fit(x: np.ndarray, t: np.ndarray, f: float) -> tuple[float, float]:
+    """(amplitude, phase in rad) of the f-Hz component of x by least squares."""
+    basis = np.column_stack([np.cos(2 * np.pi * f * t), np.sin(2 * np.pi * f * t)])
+    a, b = np.linalg.lstsq(basis, x, rcond=None)[0]
+    return float(np.hypot(a, b)), float(np.arctan2(-b, a))
+
+
+@pytest.fixture(scope="module")
+def two_tones() -> pd.DataFrame:
+    """20 s of 5 Hz + 50 Hz unit tones (phase 0.7 rad at 5 Hz) in both channels."""
+    t = np.arange(int(20 * FS)) / FS
+    x = np.cos(2 * np.pi * 5.0 * t + 0.7) + np.cos(2 * np.pi * 50.0 * t)
+    return pd.DataFrame({"time": t, "base_acc": x, "rel_acc": x})
+
+
+def test_default_config_is_the_papers_filter() -> None:
+    assert (CUTOFF, ORDER) == (20.0, 8)
+
+
+def test_analytic_response_attenuates_rocking_band_40db() -> None:
+    gain = filter_response_db(np.linspace(30.0, 80.0, 501), FS, CUTOFF, ORDER)
+    assert gain.max() <= -40.0
+
+
+def test_analytic_response_passes_0_to_10hz_within_half_db() -> None:
+    gain = filter_response_db(np.linspace(0.0, 10.0, 201), FS, CUTOFF, ORDER)
+    assert np.abs(gain).max() <= 0.5
+
+
+def test_measured_attenuation_on_tones(two_tones: pd.DataFrame) -> None:
+    out = filter_recording(two_tones, CUTOFF, ORDER)
+    t = out["time"].to_numpy()
+    mid = (t > 2.0) & (t < 18.0)
+    for channel in ("base_acc", "rel_acc"):
+        a50, _ = tone_fit(out[channel].to_numpy()[mid], t[mid], 50.0)
+        a5, _ = tone_fit(out[channel].to_numpy()[mid], t[mid], 5.0)
+        assert 20 * np.log10(a50) <= -40.0
+        assert abs(20 * np.log10(a5)) <= 0.5
+
+
+def test_zero_phase_no_delay(two_tones: pd.DataFrame) -> None:
+    t = two_tones["time"].to_numpy()
+    y = lowpass(two_tones["rel_acc"].to_numpy(), FS, CUTOFF, ORDER)
+    mid = (t > 2.0) & (t < 18.0)
+    _, phase = tone_fit(y[mid], t[mid], 5.0)
+    assert abs(phase - 0.7) < np.radians(0.1)
+    x5 = np.cos(2 * np.pi * 5.0 * t + 0.7)
+    lags = np.arange(-10, 11)
+    xc = [np.dot(np.roll(y, -lag)[mid], x5[mid]) for lag in lags]
+    assert lags[int(np.argmax(xc))] == 0
+
+
+def test_same_filter_on_both_channels(two_tones: pd.DataFrame) -> None:
+    out = filter_recording(two_tones, CUTOFF, ORDER)
+    np.testing.assert_array_equal(out["base_acc"], out["rel_acc"])
+    np.testing.assert_array_equal(out["time"], two_tones["time"])
+
+
+def test_non_uniform_time_is_a_data_error(two_tones: pd.DataFrame) -> None:
+    bad = two_tones.copy()
+    bad.loc[10, "time"] += 0.5 / FS
+    with pytest.raises(DataError, match="uniform"):
+        filter_recording(bad, CUTOFF, ORDER, source="bad.csv")
+
+
+def test_psd_integrates_to_variance() -> None:
+    x = np.random.default_rng(1).normal(0.0, 2.0, 2**14)
+    f, p = psd(x, FS)
+    assert np.sum(p) * (f[1] - f[0]) == pytest.approx(4.0, rel=0.05)
+
+
+def test_h1_of_a_gain_with_output_noise() -> None:
+    rng = np.random.default_rng(2)
+    u = rng.standard_normal(4096)
+    f, h, coh = frf_h1(u, -0.625 * u + 0.01 * rng.standard_normal(u.size), FS)
+    np.testing.assert_allclose(h[1:], -0.625, atol=0.01)
+    assert coh[1:].min() > 0.99
+
+
+def test_data_figures_are_written(two_tones: pd.DataFrame, tmp_path: Path) -> None:
+    from harvester.figures_data import fig04_psd, fig05_time_history
+
+    out = filter_recording(two_tones, CUTOFF, ORDER)
+    fig04_psd(two_tones, out, FS, CUTOFF, tmp_path / "fig04.png")
+    fig05_time_history(two_tones, out, tmp_path / "fig05.png", window=(2.0, 4.0))
+    assert (tmp_path / "fig04.png").stat().st_size > 10_000
+    assert (tmp_path / "fig05.png").stat().st_size > 10_000

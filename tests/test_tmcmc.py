@@ -1,0 +1,316 @@
+"""TMCMC kernel (harvester.tmcmc) and the batched black-box likelihood Op (harvester.batched).
+
+Problems with exact answers (linear-Gaussian evidence, conjugate Normal mean), agreement with
+PyMC's own SMC kernel, the Op's placement in ``datalogp`` and its one-call-per-batch contract,
+robustness to NaN likelihoods, reproducibility. Sampling runs are small: each takes about a
+second on one core after compilation.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pymc as pm
+import pytensor
+import pytensor.tensor as pt
+import pytest
+from pytensor.graph.replace import vectorize_graph
+from scipy.stats import multivariate_normal
+
+from harvester.batched import BatchedLogLike, loglike_potential
+from harvester.tmcmc import (
+    TMCMC,
+    TMCMCError,
+    compile_population_logp,
+    log_evidence,
+    next_beta,
+    run_tmcmc,
+    weights_cov,
+)
+
+pytestmark = pytest.mark.filterwarnings("ignore::UserWarning", "ignore::RuntimeWarning")
+
+
+@pytest.fixture(autouse=True)
+def _quiet_pymc():
+    pymc_logger = logging.getLogger("pymc")
+    level = pymc_logger.level
+    pymc_logger.setLevel(logging.ERROR)
+    yield
+    pymc_logger.setLevel(level)
+
+
+# --------------------------------------------------------------------------------------------
+# Problems with known answers
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def linear_gaussian():
+    """y = X w + noise, w ~ N(0, s0^2 I) in 3 dims, known noise: y ~ N(0, s0^2 X X^T + s^2 I)."""
+    rng = np.random.default_rng(0)
+    n, d, prior_sd, noise_sd = 20, 3, 1.0, 0.5
+    X = rng.normal(size=(n, d))
+    y = X @ rng.normal(scale=prior_sd, size=d) + rng.normal(scale=noise_sd, size=n)
+    exact = multivariate_normal(np.zeros(n), prior_sd**2 * X @ X.T + noise_sd**2 * np.eye(n))
+    with pm.Model() as model:
+        w = pm.Normal("w", 0.0, prior_sd, shape=d)
+        pm.Normal("y", pm.math.dot(X, w), noise_sd, observed=y)
+    return model, float(exact.logpdf(y))
+
+
+def test_log_evidence_linear_gaussian_default_settings(linear_gaussian):
+    # Ching & Chen's settings (scale 0.2, 2 moves) mix slowly: one chain's log evidence has a
+    # spread of about 0.45 nats here (0.1 with scale 1.0 and 5 moves), so average 48 chains
+    # (standard error about 0.07 nats; the 0.2-nat bound is about 3 standard errors).
+    model, exact = linear_gaussian
+    idata = run_tmcmc(model, draws=1000, chains=48, seed=11)
+    errors = log_evidence(idata) - exact
+    assert abs(errors.mean()) < 0.2, errors
+    assert np.all(np.abs(errors) < 2.5), errors
+    assert np.all(idata.sample_stats["n_stages"].values >= 2)
+
+
+def test_log_evidence_linear_gaussian_four_chains(linear_gaussian):
+    # A wider proposal and more moves mix well: one chain's spread is about 0.1 nats, so the
+    # mean of 4 chains has a standard error of about 0.05 nats.
+    model, exact = linear_gaussian
+    idata = run_tmcmc(model, draws=1000, chains=4, seed=12, proposal_scale=1.0, mcmc_steps=5)
+    errors = log_evidence(idata) - exact
+    assert abs(errors.mean()) < 0.2, errors
+
+
+def test_posterior_of_normal_mean_with_known_sigma():
+    y = np.array([1.2, 0.7, 2.1, 1.5, 0.9, 1.8, 1.1, 1.4])
+    prior_mean, prior_sd, noise_sd = 0.0, 2.0, 0.8
+    precision = 1 / prior_sd**2 + len(y) / noise_sd**2
+    post_mean = (prior_mean / prior_sd**2 + y.sum() / noise_sd**2) / precision
+    post_sd = precision**-0.5
+    with pm.Model() as model:
+        mu = pm.Normal("mu", prior_mean, prior_sd)
+        pm.Normal("y", mu, noise_sd, observed=y)
+    draws = run_tmcmc(model, draws=1000, chains=4, seed=3).posterior["mu"].values
+    assert draws.shape == (4, 1000)
+    # Resampled populations hold duplicates, so the effective sample size is well below 4000.
+    assert abs(draws.mean() - post_mean) < 0.15 * post_sd
+    assert abs(draws.std() / post_sd - 1) < 0.1
+
+
+def test_agrees_with_pymc_imh_kernel():
+    rng = np.random.default_rng(3)
+    z = rng.normal(1.0, 0.7, size=15)
+    with pm.Model() as model:
+        mu = pm.Normal("mu", 0.0, 2.0)
+        s = pm.HalfNormal("s", 1.0)  # log-transformed: moves happen in log(s)
+        pm.Normal("z", mu, s, observed=z)
+    ours = run_tmcmc(model, draws=1000, chains=4, seed=5)
+    imh = pm.sample_smc(1000, model=model, chains=2, cores=1, random_seed=5,
+                        progressbar=False, compute_convergence_checks=False)
+    assert abs(log_evidence(ours).mean() - log_evidence(imh).mean()) < 0.3
+    for name in ("mu", "s"):
+        ref_sd = float(imh.posterior[name].std())
+        diff = float(ours.posterior[name].mean() - imh.posterior[name].mean())
+        assert abs(diff) < 0.3 * ref_sd, (name, diff, ref_sd)
+
+
+# --------------------------------------------------------------------------------------------
+# The tempering rule
+# --------------------------------------------------------------------------------------------
+
+
+def test_next_beta_hits_target_cov_and_caps_at_one():
+    loglike = np.random.default_rng(0).normal(-50.0, 20.0, size=2000)
+    beta, log_w = next_beta(loglike, 0.0, target_cov=1.0)
+    assert 0 < beta < 1
+    assert weights_cov(log_w) == pytest.approx(1.0, rel=1e-4)
+    flat = np.full(100, -3.0)  # cov(w) = 0 for any step: go straight to the posterior
+    assert next_beta(flat, 0.3)[0] == 1.0
+
+
+def test_next_beta_with_zero_likelihood_particles():
+    loglike = np.r_[np.full(60, -np.inf), np.random.default_rng(1).normal(-5, 1, size=40)]
+    beta, log_w = next_beta(loglike, 0.0)
+    assert beta > 0  # progress even when -inf particles alone give cov(w) > target
+    assert np.all(np.isneginf(log_w[:60])) and np.all(np.isfinite(log_w[60:]))
+
+
+# --------------------------------------------------------------------------------------------
+# The batched black-box likelihood Op
+# --------------------------------------------------------------------------------------------
+
+DATA = np.array([0.3, -0.2, 0.5, 1.1, 0.8])
+
+
+def normal_loglike(theta: np.ndarray) -> np.ndarray:
+    """Rows (mu, log_sigma): Gaussian log-likelihood of DATA."""
+    mu, sigma = theta[:, :1], np.exp(theta[:, 1:2])
+    return (-0.5 * ((DATA - mu) / sigma) ** 2 - np.log(sigma) - 0.5 * np.log(2 * np.pi)).sum(1)
+
+
+class CountingLogLike:
+    """normal_loglike that records the shape of every call."""
+
+    def __init__(self, fn=normal_loglike):
+        self.fn = fn
+        self.calls: list[tuple[int, ...]] = []
+
+    def __call__(self, theta):
+        self.calls.append(theta.shape)
+        return self.fn(theta)
+
+
+def op_model(fn, as_potential=False):
+    with pm.Model() as model:
+        mu = pm.Normal("mu", 0.0, 1.0)
+        log_sigma = pm.Normal("log_sigma", -0.5, 0.5)
+        loglike_potential("loglike", fn, [mu, log_sigma], as_potential=as_potential)
+    return model
+
+
+def reference_model():
+    with pm.Model() as model:
+        mu = pm.Normal("mu", 0.0, 1.0)
+        log_sigma = pm.Normal("log_sigma", -0.5, 0.5)
+        pm.Normal("y", mu, pt.exp(log_sigma), observed=DATA)
+    return model
+
+
+@pytest.mark.parametrize("as_potential", [False, True])
+def test_op_model_has_the_same_logp_as_pm_normal(as_potential):
+    model, reference = op_model(normal_loglike, as_potential), reference_model()
+    for mu, log_sigma in [(0.0, 0.0), (0.4, -0.7), (-1.0, 0.3)]:
+        point = {"mu": np.array(mu), "log_sigma": np.array(log_sigma)}
+        for term in ("datalogp", "varlogp"):
+            ours = model.compile_fn(getattr(model, term))(point)
+            ref = reference.compile_fn(getattr(reference, term))(point)
+            assert ours == pytest.approx(ref, rel=1e-12), term
+    # Equal datalogp and varlogp: the likelihood is in datalogp (tempered by SMC), not the prior.
+    assert (len(model.observed_RVs), len(model.potentials)) == ((0, 1) if as_potential else (1, 0))
+
+
+def test_vectorized_op_is_one_call_not_a_blockwise_loop():
+    counter = CountingLogLike()
+    op = BatchedLogLike(counter, n_params=2)
+    theta = pt.vector("theta")
+    thetas = pt.matrix("thetas")
+    batched = vectorize_graph(op(theta), replace={theta: thetas})
+    assert isinstance(batched.owner.op, BatchedLogLike)
+    rows = np.random.default_rng(0).normal(size=(7, 2))
+    values = pytensor.function([thetas], batched)(rows)
+    assert counter.calls == [(7, 2)]
+    np.testing.assert_allclose(values, normal_loglike(rows))
+    with pytest.raises(NotImplementedError, match="no gradient"):
+        pytensor.grad(op(theta), theta)
+
+
+def test_population_logp_calls_fn_once_per_batch():
+    counter = CountingLogLike()
+    model, reference = op_model(counter), reference_model()
+    rows = np.random.default_rng(1).normal(size=(50, 2))
+    prior, loglike = compile_population_logp(model)(rows)
+    assert counter.calls == [(50, 2)]
+    ref_prior, ref_loglike = compile_population_logp(reference)(rows)
+    np.testing.assert_allclose(loglike, ref_loglike)
+    np.testing.assert_allclose(prior, ref_prior)
+
+
+def test_sampling_calls_fn_once_per_move():
+    counter = CountingLogLike()
+    model = op_model(counter)
+    mcmc_steps, draws = 3, 300
+    idata = run_tmcmc(model, draws=draws, chains=2, seed=2, mcmc_steps=mcmc_steps)
+    stages = idata.sample_stats["n_stages"].values
+    assert len(counter.calls) == int(np.sum(1 + mcmc_steps * stages))
+    assert set(counter.calls) == {(draws, 2)}
+    assert idata.sample_stats["n_evals_total"].values.tolist() == [
+        draws * (1 + mcmc_steps * s) for s in stages
+    ]
+
+
+def test_nan_likelihood_is_rejected_not_fatal():
+    def loglike_nan_above_one(theta):
+        out = normal_loglike(theta)
+        out[theta[:, 0] > 1.0] = np.nan
+        return out
+
+    idata = run_tmcmc(op_model(loglike_nan_above_one), draws=300, chains=2, seed=4)
+    assert np.all(idata.posterior["mu"].values <= 1.0)
+    assert np.all(np.isfinite(log_evidence(idata)))
+    op = BatchedLogLike(loglike_nan_above_one, 2)
+    theta = pt.matrix("theta")
+    values = pytensor.function([theta], op(theta))(np.array([[2.0, 0.0], [0.0, 0.0]]))
+    assert np.isneginf(values[0]) and np.isfinite(values[1])
+
+
+def test_zero_likelihood_everywhere_is_a_clear_error():
+    model = op_model(lambda theta: np.full(len(theta), -np.inf))
+    with pytest.raises(TMCMCError, match="all 100 particles have log-likelihood -inf"):
+        run_tmcmc(model, draws=100, chains=1, seed=0)
+
+
+def test_invalid_parameter_of_one_particle_does_not_poison_the_batch():
+    # PyMC checks sigma > 0; vectorize_graph alone would all()-reduce the check over particles.
+    with pm.Model() as model:
+        sigma = pm.Normal("sigma", 1.0, 1.0)  # unconstrained on purpose
+        pm.Normal("y", 0.0, sigma=sigma, observed=DATA)
+    _, loglike = compile_population_logp(model)(np.array([[1.0], [-1.0], [2.0]]))
+    assert np.isneginf(loglike[1]) and np.all(np.isfinite(loglike[[0, 2]]))
+
+
+# --------------------------------------------------------------------------------------------
+# Reproducibility and reporting
+# --------------------------------------------------------------------------------------------
+
+
+def test_same_seed_same_samples_and_evidence():
+    model = reference_model()
+    first = run_tmcmc(model, draws=300, chains=2, seed=21)
+    second = run_tmcmc(model, draws=300, chains=2, seed=21)
+    other = run_tmcmc(model, draws=300, chains=2, seed=22)
+    for name in ("mu", "log_sigma"):
+        np.testing.assert_array_equal(first.posterior[name].values, second.posterior[name].values)
+    np.testing.assert_array_equal(log_evidence(first), log_evidence(second))
+    assert not np.array_equal(first.posterior["mu"].values, other.posterior["mu"].values)
+
+
+def test_run_tmcmc_statistics_and_progress_log(caplog):
+    model = reference_model()
+    with caplog.at_level(logging.INFO, logger="harvester.tmcmc"):
+        idata = run_tmcmc(model, draws=200, chains=2, seed=1)
+    stats = idata.sample_stats
+    assert stats["log_evidence"].dims == ("chain",)
+    assert stats["beta"].dims == ("chain", "stage")
+    for chain in range(2):
+        beta = stats["beta"].values[chain]
+        beta = beta[np.isfinite(beta)]
+        assert np.all(np.diff(beta) > 0) and beta[-1] == 1.0
+        running = stats["log_marginal_likelihood"].values[chain]
+        assert running[np.isfinite(running)][-1] == stats["log_evidence"].values[chain]
+    assert np.all((stats["accept_rate"].values[np.isfinite(stats["accept_rate"].values)] > 0))
+    assert stats.attrs["wall_time_s"] > 0 and stats.attrs["kernel"] == "TMCMC"
+    assert np.all(stats["n_evals_total"].values > 0)
+    lines = [r.getMessage() for r in caplog.records if r.name == "harvester.tmcmc"]
+    assert any("stage 1: beta=" in line and "log_evidence=" in line for line in lines)
+    # A callable also works as the progress sink.
+    seen: list[str] = []
+    pm.sample_smc(100, kernel=TMCMC, model=model, chains=1, cores=1, random_seed=0,
+                  progressbar=False, compute_convergence_checks=False, log=seen.append)
+    assert any("accept=" in line for line in seen)
+
+
+def test_discrete_free_variables_are_refused():
+    with pm.Model() as model:
+        pm.Poisson("k", 3.0)
+        pm.Normal("x", 0, 1, observed=[0.1])
+    with pytest.raises(TypeError, match="continuous"):
+        run_tmcmc(model, draws=50, chains=1, seed=0)
+
+
+@pytest.mark.slow
+def test_log_evidence_linear_gaussian_spread_over_many_seeds(linear_gaussian):
+    # Per-chain bias and spread with the default settings, 60 chains.
+    model, exact = linear_gaussian
+    errors = log_evidence(run_tmcmc(model, draws=1000, chains=60, seed=99)) - exact
+    assert abs(errors.mean()) < 3 * errors.std() / np.sqrt(len(errors)) + 0.05
+    assert errors.std() < 0.6

@@ -1,0 +1,51 @@
+# Raw recordings: regenerate from the seed (bit-for-bit check), verify checksums, convert volts to m/s^2.
+
+
+rule regenerate_raw_data:
+    output:
+        directory("results/regenerated_raw"),
+    params:
+        rig=config["rig"],
+    log:
+        "logs/regenerate_raw_data.log",
+    script:
+        "../scripts/make_raw_data.py"
+
+
+rule check_raw_reproduced:
+    input:
+        committed=config["data"]["checksums"],
+        regenerated="results/regenerated_raw",
+    output:
+        "results/checks/raw_reproduced.txt",
+    log:
+        "logs/check_raw_reproduced.log",
+    script:
+        "../scripts/check_reproduced.py"
+
+
+rule verify_checksums:
+    input:
+        sums=config["data"]["checksums"],
+        files=[f for r in RECORDS for f in raw_files(r).values()]
+        + [f"{RAW}/static_friction.csv", f"{RAW}/static_friction.json"],
+    output:
+        "results/checks/raw_checksums.txt",
+    log:
+        "logs/verify_checksums.log",
+    script:
+        "../scripts/verify_checksums.py"
+
+
+rule convert:
+    input:
+        unpack(lambda w: raw_files(w.record)),
+        checked="results/checks/raw_checksums.txt",
+    output:
+        "results/data/{record}_acc.csv",
+    wildcard_constraints:
+        record="|".join(RECORDS),
+    log:
+        "logs/convert_{record}.log",
+    script:
+        "../scripts/convert.py"

@@ -1,0 +1,57 @@
+# Initial modelling (paper section "Initial modelling"): static friction, viscous damping, Table 1, priors.
+
+
+rule static_friction:
+    input:
+        csv=f"{RAW}/static_friction.csv",
+        meta=f"{RAW}/static_friction.json",
+        checked="results/checks/raw_checksums.txt",
+    output:
+        "results/initial/static_friction.json",
+    params:
+        k=config["rig"]["k"],
+    log:
+        "logs/static_friction.log",
+    script:
+        "../scripts/static_friction.py"
+
+
+rule damping_fit:
+    input:
+        data="results/data/training_filtered.csv",
+        static="results/initial/static_friction.json",
+    output:
+        fit="results/initial/damping_fit.json",
+        figure=report("results/figures/fig_initial_damping_fit.png",
+                      caption="../report/damping_fit.rst", category="Initial modelling"),
+    params:
+        rig=config["rig"],
+        band=config["initial"]["damping_fit_band_hz"],
+        lead_in=config["preprocess"]["training_lead_in"],
+        samples=config["preprocess"]["training_samples"],
+    log:
+        "logs/damping_fit.log",
+    script:
+        "../scripts/damping_fit.py"
+
+
+rule table1:
+    input:
+        static="results/initial/static_friction.json",
+        damping="results/initial/damping_fit.json",
+    output:
+        table1=report("results/tables/table1_initial_estimates.csv",
+                      caption="../report/table1.rst", category="Initial modelling"),
+        table1_md="results/tables/table1_initial_estimates.md",
+        table2=report("results/tables/table2_priors_linear.csv",
+                      caption="../report/table2.rst", category="Initial modelling"),
+        table4=report("results/tables/table4_priors_tanh.csv",
+                      caption="../report/table4.rst", category="Initial modelling"),
+        priors="results/initial/priors.json",
+    params:
+        rig=config["rig"],
+        priors=config["priors"],
+    log:
+        "logs/table1.log",
+    script:
+        "../scripts/table1.py"

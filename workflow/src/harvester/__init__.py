@@ -1,0 +1,1 @@
+"""Bayesian system identification of friction-dominated mechanical devices."""

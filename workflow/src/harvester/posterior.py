@@ -1,0 +1,84 @@
+"""Posterior summaries (Tables 3 and 5) and model evidence (eqs. 7, 11 and 12)."""
+
+from __future__ import annotations
+
+import arviz as az
+import numpy as np
+import pandas as pd
+from scipy.special import logsumexp
+
+#: Columns of the posterior tables (Tables 3 and 5).
+POSTERIOR_COLUMNS = ["parameter", "mean", "sd", "q2.5", "q97.5", "paper", "truth"]
+
+
+def samples(idata: az.InferenceData, names: list[str] | tuple[str, ...]) -> np.ndarray:
+    """Posterior samples pooled over chains, shape (samples, len(names))."""
+    post = idata.posterior
+    return np.column_stack([post[n].values.reshape(-1) for n in names])
+
+
+def parameter_names(idata: az.InferenceData) -> list[str]:
+    """Identified parameters in the order stored (physical parameters, sigma last)."""
+    names = list(idata.posterior.attrs.get("parameter_names", "").split(",")) \
+        if idata.posterior.attrs.get("parameter_names") else \
+        [v for v in idata.posterior.data_vars if not v.endswith("__")]
+    return [n for n in names if n]
+
+
+def summary_table(idata: az.InferenceData, paper: dict[str, float],
+                  truth: dict[str, float]) -> pd.DataFrame:
+    """Posterior mean, sd and 95% interval of each parameter beside the paper's and the truth."""
+    rows = []
+    for name in parameter_names(idata):
+        x = idata.posterior[name].values.reshape(-1)
+        rows.append({
+            "parameter": name, "mean": x.mean(), "sd": x.std(ddof=1),
+            "q2.5": np.quantile(x, 0.025), "q97.5": np.quantile(x, 0.975),
+            "paper": paper.get(name, np.nan), "truth": truth.get(name, np.nan),
+        })
+    return pd.DataFrame(rows, columns=POSTERIOR_COLUMNS)
+
+
+def log_evidence_per_chain(idata: az.InferenceData) -> np.ndarray:
+    """Log evidence ln P(D|M), eq. (11), one estimate per TMCMC chain."""
+    return np.asarray(idata.sample_stats.attrs["log_evidence"], dtype=float).reshape(-1)
+
+
+def evidence_table(evidences: dict[str, np.ndarray]) -> pd.DataFrame:
+    """Rows (model, chain, log_evidence)."""
+    rows = [{"model": m, "chain": c, "log_evidence": float(v)}
+            for m, ev in evidences.items() for c, v in enumerate(ev)]
+    return pd.DataFrame(rows, columns=["model", "chain", "log_evidence"])
+
+
+def pooled_log_evidence(chains: np.ndarray) -> float:
+    """Evidence pooled over chains: the log of the mean of the chains' evidences."""
+    chains = np.asarray(chains, dtype=float)
+    return float(logsumexp(chains) - np.log(len(chains)))
+
+
+def bayes_factor_table(evidences: dict[str, np.ndarray], reference: str | None = None,
+                       paper: dict[tuple[str, str], float] | None = None) -> pd.DataFrame:
+    """Log Bayes factor of each model over ``reference`` (eq. 12, equal prior probabilities).
+
+    The spread is the standard deviation over chains of the per-chain differences, pairing chains
+    by index (chains are independent, so this is the spread of one-chain estimates).
+    """
+    models = list(evidences)
+    reference = reference or models[0]
+    ref = evidences[reference]
+    rows = []
+    for m in models:
+        if m == reference:
+            continue
+        n = min(len(ref), len(evidences[m]))
+        diff = evidences[m][:n] - ref[:n]
+        rows.append({
+            "model": m, "reference": reference,
+            "log_bayes_factor": pooled_log_evidence(evidences[m]) - pooled_log_evidence(ref),
+            "sd_over_chains": float(np.std(diff, ddof=1)) if n > 1 else np.nan,
+            "min": float(diff.min()), "max": float(diff.max()),
+            "paper": (paper or {}).get((m, reference), np.nan),
+        })
+    return pd.DataFrame(rows, columns=["model", "reference", "log_bayes_factor",
+                                       "sd_over_chains", "min", "max", "paper"])

@@ -1,0 +1,391 @@
+"""The virtual rig: SIMULATED raw recordings of the ball-screw harvester (not the paper's data).
+
+Green et al. (2015) did not publish their recordings, so this module plays the test rig of
+their Figure 2: a shaker, the device of eq. (1) with a friction law richer than the models
+identified later, a rocking mode of the mass, two DC-coupled MEMS accelerometers and a DAQ.
+It is deliberately independent of the identification code (``simulate.py``, ``physics.py``).
+
+Device, eq. (1), z = x - y positive up:
+
+    M z'' + c_m z' + k z + f = -m y''.
+
+Friction f (N) of the rig, with F_hold = -m y'' - k z the force the friction must hold at rest:
+
+* sliding (z' != 0): f = sgn(z') max(F_s, F_c tanh(beta |z'|)). Above
+  v_floor = atanh(F_s / F_c) / beta (0.010 m/s for the config) this is the paper's tanh law;
+  below it the friction stays at the static level F_s (a Coulomb floor), so a slowing mass is
+  brought to rest. With F_s = 0 the law is exactly F_c tanh(beta z').
+* sticking: when |z'| < v_stick (or z' reaches zero within a step) and |F_hold| <= F_s the mass
+  sticks: z' = 0, z'' = 0, f = F_hold. It breaks away when |F_hold| exceeds F_s.
+
+Method: fixed-step classical RK4 at the internal rate (``oversample`` x 256 Hz) with y''
+linearly interpolated within each step, compiled with numba. Stick-slip events are located
+inside the step: a breakaway at the exact instant |F_hold| reaches F_s (F_hold is linear in time
+while stuck), a velocity reversal by linear interpolation of z', after which the step is
+re-integrated in two parts so that RK4 never straddles the sign change of f. The velocity
+discarded on sticking from the band |z'| < v_stick is booked as an impulse in z''.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numba as nb
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+from scipy import signal
+
+#: Standard gravity (m/s^2), also used by the DAQ converter.
+G = 9.80665
+#: Half-length of the anti-alias FIR, in output samples (filter spans 2 x 24 / 256 s).
+AA_HALF_OUTPUT_SAMPLES = 24
+#: Anti-alias -6 dB point as a fraction of the output rate, and Kaiser window beta (~80 dB).
+AA_CUTOFF_FRACTION = 0.44
+AA_KAISER_BETA = 8.0
+#: Simulated time (s) allowed for a static friction test to come to rest.
+STATIC_TEST_DURATION_S = 20.0
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Device:
+    """Mechanical parameters of the rig (SI units): eq. (1) plus stiction."""
+
+    M: float        # kg, effective mass, eq. (2)
+    m: float        # kg, oscillating mass
+    k: float        # N/m
+    c_m: float      # N s/m, translational viscous coefficient b_m of eq. (1)
+    F_c: float      # N, tanh friction amplitude
+    beta: float     # s/m, tanh friction slope
+    F_s: float      # N, static (breakaway) friction and sliding floor
+    v_stick: float  # m/s, speed below which the mass may stick
+
+    @classmethod
+    def from_config(cls, rig: Mapping[str, Any]) -> Device:
+        fr = rig["friction"]
+        if fr["law"] != "tanh":
+            raise ValueError(f"rig friction law must be 'tanh', got {fr['law']!r}")
+        return cls(M=float(rig["M"]), m=float(rig["m"]), k=float(rig["k"]),
+                   c_m=float(rig["c_m"]), F_c=float(fr["F_c"]), beta=float(fr["beta"]),
+                   F_s=float(fr["F_s"]), v_stick=float(fr["v_stick"]))
+
+    @property
+    def v_floor(self) -> float:
+        """Speed (m/s) above which the tanh law exceeds F_s; inf if it never does."""
+        if self.F_s <= 0.0:
+            return 0.0
+        if self.F_s >= self.F_c:
+            return math.inf
+        return math.atanh(self.F_s / self.F_c) / self.beta
+
+
+def ground_truth(rig: Mapping[str, Any]) -> dict[str, float]:
+    """The rig's true parameters (SI units) as the config sets them."""
+    dev = Device.from_config(rig)
+    rock = rig["rocking"]
+    return {
+        "M": dev.M, "m": dev.m, "k": dev.k, "c_m": dev.c_m,
+        "F_c": dev.F_c, "beta": dev.beta, "F_s": dev.F_s,
+        "v_stick": dev.v_stick, "v_floor": dev.v_floor,
+        "rocking_frequency_hz": float(rock["frequency_hz"]),
+        "rocking_damping_ratio": float(rock["damping_ratio"]),
+        "rocking_gain": float(rock["gain"]),
+        "noise_m_s2": float(rig["sensors"]["noise_m_s2"]),
+        "excitation_peak_m_s2": float(rig["excitation"]["peak_m_s2"]),
+    }
+
+
+# --------------------------------------------------------------------------- excitation
+
+def base_excitation(n: int, fs: float, cutoff_hz: float, order: int, peak: float,
+                    rng: np.random.Generator, n_scale: int | None = None) -> Array:
+    """Shaker acceleration y'' (m/s^2): Gaussian white noise through a Butterworth low-pass.
+
+    Scaled so that max |y''| over the first ``n_scale`` samples (default all) equals ``peak``.
+    """
+    sos = signal.butter(order, cutoff_hz, btype="low", fs=fs, output="sos")
+    y = signal.sosfilt(sos, rng.standard_normal(n))
+    return y * (peak / np.max(np.abs(y[:n_scale])))
+
+
+# --------------------------------------------------------------------------- mechanics
+
+@nb.njit(cache=True)
+def _friction(v, hold, F_c, beta, F_s):
+    """Friction (N): Coulomb-floored tanh while sliding; at v == 0 the reaction, capped at F_s."""
+    if v > 0.0:
+        return max(F_s, F_c * math.tanh(beta * v))
+    if v < 0.0:
+        return -max(F_s, -F_c * math.tanh(beta * v))
+    return min(max(hold, -F_s), F_s)
+
+
+@nb.njit(cache=True)
+def _acc(drive, z, v, M, k, c, F_c, beta, F_s):
+    """Relative acceleration z'' (m/s^2) while sliding, eq. (1); drive = -m y'' (N)."""
+    hold = drive - k * z
+    return (hold - c * v - _friction(v, hold, F_c, beta, F_s)) / M
+
+
+@nb.njit(cache=True)
+def _rk4(z, v, h, fa, fb, M, k, c, F_c, beta, F_s):
+    """One RK4 step of length h; the drive goes linearly from fa to fb over the step."""
+    fm = 0.5 * (fa + fb)
+    a1 = _acc(fa, z, v, M, k, c, F_c, beta, F_s)
+    z2, v2 = z + 0.5 * h * v, v + 0.5 * h * a1
+    a2 = _acc(fm, z2, v2, M, k, c, F_c, beta, F_s)
+    z3, v3 = z + 0.5 * h * v2, v + 0.5 * h * a2
+    a3 = _acc(fm, z3, v3, M, k, c, F_c, beta, F_s)
+    z4, v4 = z + h * v3, v + h * a3
+    a4 = _acc(fb, z4, v4, M, k, c, F_c, beta, F_s)
+    return (z + h / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4),
+            v + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4))
+
+
+@nb.njit(cache=True)
+def _integrate(drive, dt, z0, v0, M, k, c, F_c, beta, F_s, v_stick):
+    """Stick-slip integration of eq. (1) on the grid of ``drive``; returns z, z', z'', f, stuck."""
+    n = drive.size
+    z = np.empty(n)
+    v = np.empty(n)
+    jump = np.zeros(n)
+    stuck = np.zeros(n, dtype=np.bool_)
+    z[0], v[0] = z0, v0
+    is_stuck = v0 == 0.0 and abs(drive[0] - k * z0) <= F_s
+    stuck[0] = is_stuck
+    for i in range(n - 1):
+        fa, fb = drive[i], drive[i + 1]
+        if is_stuck:
+            hold_b = fb - k * z[i]
+            if abs(hold_b) <= F_s:
+                z[i + 1], v[i + 1], stuck[i + 1] = z[i], 0.0, True
+                continue
+            hold_a = fa - k * z[i]  # breakaway where F_hold crosses +-F_s (linear in time)
+            edge = F_s if hold_b > 0.0 else -F_s
+            th = min(max((edge - hold_a) / (hold_b - hold_a), 0.0), 1.0)
+            zi, vi = _rk4(z[i], 0.0, (1.0 - th) * dt, fa + th * (fb - fa), fb,
+                          M, k, c, F_c, beta, F_s)
+            is_stuck = False
+        else:
+            zi, vi = _rk4(z[i], v[i], dt, fa, fb, M, k, c, F_c, beta, F_s)
+            if F_s > 0.0 and v[i] != 0.0 and vi * v[i] <= 0.0:
+                th = v[i] / (v[i] - vi)  # velocity reversal inside the step
+                fm = fa + th * (fb - fa)
+                zs, _ = _rk4(z[i], v[i], th * dt, fa, fm, M, k, c, F_c, beta, F_s)
+                if abs(fm - k * zs) <= F_s:
+                    zi, vi, is_stuck = zs, 0.0, True
+                else:
+                    zi, vi = _rk4(zs, 0.0, (1.0 - th) * dt, fm, fb, M, k, c, F_c, beta, F_s)
+        if not is_stuck and abs(vi) < v_stick and abs(fb - k * zi) <= F_s:
+            jump[i + 1] = -vi
+            vi, is_stuck = 0.0, True
+        z[i + 1], v[i + 1], stuck[i + 1] = zi, vi, is_stuck
+    a = np.empty(n)
+    f = np.empty(n)
+    for i in range(n):
+        hold = drive[i] - k * z[i]
+        if stuck[i]:
+            a[i], f[i] = jump[i] / dt, hold
+        else:
+            f[i] = _friction(v[i], hold, F_c, beta, F_s)
+            a[i] = (hold - c * v[i] - f[i]) / M
+    return z, v, a, f, stuck
+
+
+@dataclass(frozen=True)
+class Motion:
+    """Mass motion on the simulation grid: z (m), z' (m/s), z'' (m/s^2), friction f (N)."""
+
+    z: Array
+    v: Array
+    acc: Array
+    friction: Array
+    stuck: NDArray[np.bool_]
+
+
+def simulate_motion(y_dd: Array, fs: float, dev: Device, z0: float = 0.0,
+                    v0: float = 0.0) -> Motion:
+    """Integrate eq. (1) with the rig's stick-slip friction; y'' (m/s^2) sampled at fs (Hz)."""
+    drive = -dev.m * np.ascontiguousarray(y_dd, dtype=np.float64)
+    z, v, a, f, stuck = _integrate(drive, 1.0 / fs, float(z0), float(v0), dev.M, dev.k,
+                                   dev.c_m, dev.F_c, dev.beta, dev.F_s, dev.v_stick)
+    return Motion(z, v, a, f, stuck)
+
+
+# --------------------------------------------------------------------------- rocking mode
+
+def rocking_acceleration(friction: Array, fs: float, M: float,
+                         rocking: Mapping[str, Any]) -> Array:
+    """Rocking acceleration r (m/s^2) seen by the mass accelerometer, not in eq. (1).
+
+    A second-order mode driven by the rate ("jerk") of the screw force on the mass, -f:
+
+        r'' + 2 zeta w r' + w^2 r = -2 zeta w gain d/dt (f / M),   w = 2 pi frequency_hz,
+
+    a band-pass whose peak ratio |r| / |f / M| is ``gain`` at the rocking frequency. The
+    friction jumps at stick-slip transitions make f broadband; while stuck f = -m y'' - k z, so
+    the base acceleration drives the mode too. Discretised by the bilinear transform.
+    """
+    w = 2.0 * np.pi * float(rocking["frequency_hz"])
+    zeta = float(rocking["damping_ratio"])
+    gain = float(rocking["gain"])
+    b, a = signal.bilinear([2.0 * zeta * w * gain, 0.0], [1.0, 2.0 * zeta * w, w * w], fs)
+    return signal.lfilter(b, a, -friction / M)
+
+
+# --------------------------------------------------------------------------- measurement chain
+
+def sensor_volts(acc: Array, sensor: Mapping[str, Any]) -> Array:
+    """MEMS accelerometer output (V): vertical and DC-coupled, so it reads acc + 1 g.
+
+    V = zero_g_V + sensitivity (acc / g + 1), saturating at zero_g_V +- sensitivity range_g.
+    """
+    sens = float(sensor["sensitivity_mV_per_g"]) / 1000.0
+    zero = float(sensor["zero_g_V"])
+    swing = sens * float(sensor["range_g"])
+    return np.clip(zero + sens * (acc / G + 1.0), zero - swing, zero + swing)
+
+
+def anti_alias_taps(oversample: int) -> Array:
+    """Linear-phase FIR of the DAQ (unit DC gain): -6 dB at 0.44 x output rate, ~80 dB stop."""
+    half = AA_HALF_OUTPUT_SAMPLES * oversample
+    return signal.firwin(2 * half + 1, AA_CUTOFF_FRACTION * 2.0 / oversample,
+                         window=("kaiser", AA_KAISER_BETA))
+
+
+def decimate(x: Array, oversample: int, n_out: int) -> Array:
+    """Anti-alias filter and keep every ``oversample``-th sample, delay compensated.
+
+    ``x`` holds ``half`` samples before the first output instant and at least ``half`` after
+    the last (``half`` = filter half-length), so no output sample sees padding.
+    """
+    h = anti_alias_taps(oversample)
+    half = (h.size - 1) // 2
+    y = signal.upfirdn(h, x, up=1, down=oversample)
+    first = 2 * half // oversample
+    out = y[first:first + n_out]
+    if out.size != n_out:
+        raise ValueError("signal too short for the anti-alias filter margins")
+    return out
+
+
+def quantise(volts: Array, bits: int, range_V: tuple[float, float]) -> Array:
+    """ADC: round to the nearest of 2**bits codes over range_V, saturating at the end codes."""
+    lo, hi = range_V
+    lsb = (hi - lo) / 2**bits
+    code = np.clip(np.rint((volts - lo) / lsb), 0, 2**bits - 1)
+    return lo + code * lsb
+
+
+def noise_rms_internal(noise_m_s2: float, oversample: int) -> float:
+    """Internal-rate white-noise RMS (m/s^2) that leaves ``noise_m_s2`` after the DAQ filter."""
+    h = anti_alias_taps(oversample)
+    return noise_m_s2 / float(np.sqrt(np.sum(h * h)))
+
+
+# --------------------------------------------------------------------------- records
+
+@dataclass(frozen=True)
+class RecordSimulation:
+    """One simulated DAQ record: channel voltages at the output rate and the rig's truth.
+
+    ``truth`` holds, at the output instants: ``base_acc`` (y''), ``rel_acc`` (z''),
+    ``rocking`` (r) in m/s^2 through the same anti-alias filter as the channels (no noise);
+    ``z`` (m), ``v`` (m/s) and ``stuck`` (bool) sampled.
+    """
+
+    name: str
+    seed: int
+    sampling_rate_hz: float
+    time: Array
+    ai0: Array
+    ai1: Array
+    truth: dict[str, NDArray[Any]]
+
+
+def record_seed(rig: Mapping[str, Any], name: str) -> int:
+    """Excitation/noise seed of a record: rig seed + the record's seed_offset."""
+    return int(rig["seed"]) + int(rig["records"][name]["seed_offset"])
+
+
+def simulate_record(rig: Mapping[str, Any], name: str,
+                    duration_s: float | None = None) -> RecordSimulation:
+    """Run the rig for record ``name`` from rest; ``duration_s`` overrides the config's length."""
+    daq, exc, sens = rig["daq"], rig["excitation"], rig["sensors"]
+    fs_out = float(daq["sampling_rate_hz"])
+    os_ = int(daq["oversample"])
+    fs = fs_out * os_
+    duration = float(rig["records"][name]["duration_s"] if duration_s is None else duration_s)
+    n_out = int(round(duration * fs_out))
+    half = AA_HALF_OUTPUT_SAMPLES * os_
+    n_rec = n_out * os_
+    seed = record_seed(rig, name)
+    rng_exc, rng_base, rng_mass = (np.random.default_rng(s)
+                                   for s in np.random.SeedSequence(seed).spawn(3))
+
+    y_dd = np.zeros(half + n_rec + half)  # rig at rest before t = 0
+    y_dd[half:] = base_excitation(n_rec + half, fs, float(exc["cutoff_hz"]), int(exc["order"]),
+                                  float(exc["peak_m_s2"]), rng_exc, n_scale=n_rec)
+    dev = Device.from_config(rig)
+    motion = simulate_motion(y_dd, fs, dev)
+    rock = rocking_acceleration(motion.friction, fs, dev.M, rig["rocking"])
+    sd = noise_rms_internal(float(sens["noise_m_s2"]), os_)
+    base = y_dd + sd * rng_base.standard_normal(y_dd.size)
+    mass = y_dd + motion.acc + rock + sd * rng_mass.standard_normal(y_dd.size)
+
+    bits, range_V = int(daq["bits"]), (float(daq["range_V"][0]), float(daq["range_V"][1]))
+
+    def channel(acc: Array) -> Array:
+        return quantise(decimate(sensor_volts(acc, sens), os_, n_out), bits, range_V)
+
+    at = slice(half, half + n_rec, os_)
+    truth = {"base_acc": decimate(y_dd, os_, n_out), "rel_acc": decimate(motion.acc, os_, n_out),
+             "rocking": decimate(rock, os_, n_out), "z": motion.z[at], "v": motion.v[at],
+             "stuck": motion.stuck[at]}
+    return RecordSimulation(name=name, seed=seed, sampling_rate_hz=fs_out,
+                            time=np.arange(n_out) / fs_out, ai0=channel(base), ai1=channel(mass),
+                            truth=truth)
+
+
+# --------------------------------------------------------------------------- static friction test
+
+def static_rest_position(dev: Device, x0: float, fs: float,
+                         duration_s: float = STATIC_TEST_DURATION_S) -> float:
+    """Rest position (m) of the vertical device released from rest at x0 (m).
+
+    Positions are downward-positive from the frictionless equilibrium (spring extension mg/k),
+    so gravity only sets the datum and eq. (1) holds with y'' = 0; the friction includes
+    stiction. Raises RuntimeError if the mass is still moving after ``duration_s``.
+    """
+    motion = simulate_motion(np.zeros(int(duration_s * fs) + 1), fs, dev, z0=x0)
+    if not motion.stuck[-1]:
+        raise RuntimeError(f"mass released at {x0} m still moving after {duration_s} s")
+    return float(motion.z[-1])
+
+
+def static_friction_test(rig: Mapping[str, Any]) -> pd.DataFrame:
+    """Static friction tests of eqs. (4)-(5): rest positions after release, downward-positive.
+
+    Each repeat displaces the mass DOWN by the stiction-band edge F_s/k plus an offset drawn
+    from ``release_offset_m`` and releases it (rest position x1 ~ +F_s/k), then UP (x2 ~ -F_s/k).
+    A reading scatter N(0, reading_sd_m) is added. With this convention F_s ~ k (x1 - x2) / 2
+    (the paper's 2F_c = k(x2 - x1) measures x from the other side). Columns: repeat,
+    direction ('down'/'up'), position_m.
+    """
+    st = rig["static_test"]
+    dev = Device.from_config(rig)
+    fs = float(rig["daq"]["sampling_rate_hz"]) * int(rig["daq"]["oversample"])
+    rng = np.random.default_rng(int(rig["seed"]) + int(st["seed_offset"]))
+    lo, hi = (float(x) for x in st["release_offset_m"])
+    rows = []
+    for repeat in range(1, int(st["repeats"]) + 1):
+        for direction, sign in (("down", 1.0), ("up", -1.0)):
+            x0 = sign * (dev.F_s / dev.k + rng.uniform(lo, hi))
+            rest = static_rest_position(dev, x0, fs)
+            rows.append((repeat, direction, rest + rng.normal(0.0, float(st["reading_sd_m"]))))
+    return pd.DataFrame(rows, columns=["repeat", "direction", "position_m"])
