@@ -17,6 +17,8 @@ include: "workflow/rules/data.smk"
 include: "workflow/rules/preprocess.smk"
 include: "workflow/rules/initial.smk"
 include: "workflow/rules/identify.smk"
+include: "workflow/rules/validate.smk"
+include: "workflow/rules/summary.smk"
 
 
 rule all:

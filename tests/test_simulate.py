@@ -71,6 +71,7 @@ TERM_PARAMS = {
     "hysteresis": [2.0, 2e4],
     "unmodelled_mode": [6.0, 0.05, 0.5],
     "inertia_error": [0.8],
+    "offset_force": [3.0],
 }
 
 
@@ -134,3 +135,11 @@ def test_failed_simulation_is_flagged_not_raised(base_acc):
                    base_acc, DT)
     assert list(sim.ok) == [False, False, True]
     assert np.isnan(sim.rel_acc[:2]).all()
+
+
+def test_force_input_is_newton_on_the_mass():
+    """A constant force F on a free mass with viscous damping: v -> F / c exponentially."""
+    n, F = 512, 10.0
+    sim = simulate(Layout.of([]), [5.0, 5.0, 0.0, 20.0], np.full(n, F), DT, force_input=True)
+    t = np.arange(n) * DT
+    np.testing.assert_allclose(sim.rel_vel[0], F / 20.0 * (1 - np.exp(-4.0 * t)), atol=1e-9)

@@ -34,4 +34,9 @@ def all_outputs():
         *[posterior_figure(m) for m in MODELS],
         "results/tables/evidence.csv",
         "results/tables/bayes_factor.csv",
+        "results/tables/validation.csv",
+        "results/figures/fig07_linear_training.png",
+        "results/figures/fig09_tanh_unseen_section.png",
+        "results/figures/fig10_tanh_unseen_full.png",
+        "results/tables/headline.csv",
     ]

@@ -60,11 +60,12 @@ class BatchedLogLike(Op):
     Notes
     -----
     No gradient: use gradient-free samplers (TMCMC, SMC, Metropolis). ``fn`` must be picklable
-    by ``cloudpickle`` if chains are run in parallel processes.
+    by ``cloudpickle`` if chains are run in parallel processes. Two instances are equal only if
+    they are the same object (no ``__props__``), so ``fn`` need not be hashable and PyTensor
+    never merges likelihoods built from different callables.
     """
 
     gufunc_signature = "(p)->()"
-    __props__ = ("fn", "n_params")
 
     def __init__(self, fn: LogLikeFn, n_params: int, name: str | None = None) -> None:
         if not callable(fn):

@@ -47,7 +47,7 @@ def fig04_psd(raw_df: pd.DataFrame, filtered_df: pd.DataFrame, fs: float, cutoff
     ax.semilogy(f_fil, p_fil, color=MODEL, lw=1.0, label=f"filtered ({cutoff:g} Hz low-pass)")
     ax.axvline(cutoff, color=MODEL, lw=0.6, ls="--")
     ax.set_xlim(0.0, fs / 2.0)
-    ax.set_ylim(bottom=max(p_fil[p_fil > 0].min(), p_raw.max() * 1e-12))
+    ax.set_ylim(bottom=max(p_fil[p_fil > 0].min(), p_raw.max() * 1e-9))
     ax.set_xlabel("Frequency (Hz)")
     ax.set_ylabel(r"PSD of $\ddot z$ ((m/s$^2$)$^2$/Hz)")
     ax.set_title("Figure 4: filtered and unfiltered relative acceleration PSD", fontsize=10)
@@ -79,7 +79,7 @@ def fig_damping_fit(fit: DampingFit, path: str | Path) -> None:
     """FRF z''/y'' (magnitude, phase in degrees, coherence) of the training data (grey) and of
     the fitted equivalent-linear model (black: same H1 estimator; dashed: exact FRF)."""
     f = fit.freqs_hz
-    show = (f > 0.0) & (f <= 4.0 * fit.band_hz[1])
+    show = (f > 0.0) & (f <= 2.0 * fit.band_hz[1])
     fig, axes = plt.subplots(3, 1, figsize=(6.4, 6.4), sharex=True,
                              gridspec_kw={"height_ratios": [3, 2, 1]})
     for ax in axes:
@@ -98,6 +98,7 @@ def fig_damping_fit(fit: DampingFit, path: str | Path) -> None:
     axes[2].set_ylim(0.0, 1.05)
     axes[2].set_xlabel("Frequency (Hz)")
     axes[0].legend(fontsize=8, frameon=False)
-    axes[0].set_title(f"Damping fit: c_m = {fit.c_m:.1f} N s/m, c_eq = {fit.c_eq:.1f} N s/m "
+    axes[0].set_title("Initial modelling: equivalent-linear fit of the FRF (band shaded)\n"
+                      f"c_m = {fit.c_m:.1f} N s/m, c_eq = {fit.c_eq:.1f} N s/m "
                       f"(F_c = {fit.F_c:.2f} N, sigma_v = {fit.sigma_v:.4f} m/s)", fontsize=9)
     _finish(fig, path)

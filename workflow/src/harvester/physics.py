@@ -108,6 +108,9 @@ _TERMS: tuple[Term, ...] = (
         Parameter("mass_mode", "kg", 0.5, 0.5, 0.0, "modal mass of the secondary mode"),
     ), n_states=2, equation="u'' + 2 zeta w_n u' + w_n^2 u = -x'', force on mass m_2 (w_n^2 u + 2 zeta w_n u')",
         description="secondary resonance attached to the mass", kind="mode"),
+    Term("offset_force", 12, (
+        Parameter("F_offset", "N", 0.0, 5.0, None, "constant force (gravity, cable, bias)"),
+    ), equation="f = F_offset", description="constant force offset", kind="mass"),
     Term("inertia_error", 11, (
         Parameter("dM", "kg", 0.0, 1.0, None, "error of the assumed effective mass"),
     ), equation="M -> M + dM", description="effective mass differs from the assumed value",

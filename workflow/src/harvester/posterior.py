@@ -39,11 +39,6 @@ def summary_table(idata: az.InferenceData, paper: dict[str, float],
     return pd.DataFrame(rows, columns=POSTERIOR_COLUMNS)
 
 
-def log_evidence_per_chain(idata: az.InferenceData) -> np.ndarray:
-    """Log evidence ln P(D|M), eq. (11), one estimate per TMCMC chain."""
-    return np.asarray(idata.sample_stats.attrs["log_evidence"], dtype=float).reshape(-1)
-
-
 def evidence_table(evidences: dict[str, np.ndarray]) -> pd.DataFrame:
     """Rows (model, chain, log_evidence)."""
     rows = [{"model": m, "chain": c, "log_evidence": float(v)}
@@ -82,3 +77,16 @@ def bayes_factor_table(evidences: dict[str, np.ndarray], reference: str | None =
         })
     return pd.DataFrame(rows, columns=["model", "reference", "log_bayes_factor",
                                        "sd_over_chains", "min", "max", "paper"])
+
+
+def posterior_truth(config_rig: dict, model: str) -> dict[str, float]:
+    """The virtual rig's values of a structure's parameters, where the structure contains them.
+
+    The rig's kinetic friction is the tanh law, so ``tanh`` has a truth for c_m, F_c and beta;
+    the linear model's c_m is an equivalent damping with no true value. sigma has none either
+    (it absorbs sensor noise and the rig's unmodelled stiction).
+    """
+    if model.split("+")[0] != "tanh" or config_rig["friction"]["law"] != "tanh":
+        return {}
+    f = config_rig["friction"]
+    return {"c_m": float(config_rig["c_m"]), "F_c": float(f["F_c"]), "beta": float(f["beta"])}

@@ -115,3 +115,19 @@ def validation_rows(model: str, data: str, measured: np.ndarray,
 
 def validation_table(rows: list[dict]) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=VALIDATION_COLUMNS)
+
+
+def save_band(path, band: PredictiveBand, measured: np.ndarray, model: str, data: str) -> None:
+    """Write an ensemble and the measured signal it is compared with (.npz), atomically."""
+    from harvester.fileio import atomic_path
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, time=band.time, responses=band.responses.astype(np.float32),
+                                sigma=band.sigma, measured=measured, model=model, data=data)
+
+
+def load_band(path) -> tuple[PredictiveBand, np.ndarray, str, str]:
+    """Read what :func:`save_band` wrote: (band, measured, model, data)."""
+    with np.load(path) as f:
+        band = PredictiveBand(f["time"], f["responses"].astype(float), f["sigma"])
+        return band, f["measured"], str(f["model"]), str(f["data"])

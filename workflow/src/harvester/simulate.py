@@ -32,8 +32,18 @@ BACKLASH_ALPHA = 100.0
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _rhs(s, yb, p, codes, poff, soff, ds):
-    """Time derivative ds of state s = [z, z', internal...]; returns the relative acceleration."""
+def _rhs(s, u, p, codes, poff, soff, ds, force_input):
+    """Time derivative ds of state s = [z, z', internal...]; returns the relative acceleration.
+
+    The input u is the base acceleration y'' (drive -m y'') or, with ``force_input``, a force
+    applied to the mass (N) with the base fixed (y'' = 0).
+    """
+    if force_input:
+        drive = u
+        yb = 0.0
+    else:
+        drive = -p[1] * u
+        yb = u
     z = s[0]
     v = s[1]
     M = p[0]
@@ -75,6 +85,8 @@ def _rhs(s, yb, p, codes, poff, soff, ds):
                 f_mass += p[o + 1] * (z - p[o])
             elif z < -p[o]:
                 f_mass += p[o + 1] * (z + p[o])
+        elif code == 12:
+            f_mass += p[o]
         elif code == 9:
             h = s[q]
             f_screw += h
@@ -84,7 +96,7 @@ def _rhs(s, yb, p, codes, poff, soff, ds):
             f_mode += p[o + 2] * (wn * wn * s[q] + 2.0 * p[o + 1] * wn * s[q + 1])
     ds[0] = v
     if backlash < 0:
-        a = (-m * yb - f_screw - f_mass + f_mode) / M
+        a = (drive - f_screw - f_mass + f_mode) / M
         ds[1] = a
     else:
         o = poff[backlash]
@@ -98,7 +110,7 @@ def _rhs(s, yb, p, codes, poff, soff, ds):
             fb = max(kb * (d - gap) * (1.0 + BACKLASH_ALPHA * s[q + 1]), 0.0)
         elif d < -gap:
             fb = min(kb * (d + gap) * (1.0 - BACKLASH_ALPHA * s[q + 1]), 0.0)
-        a = (-m * yb - f_mass - fb + f_mode) / m
+        a = (drive - f_mass - fb + f_mode) / m
         r_acc = (fb - f_screw) / j_eq
         ds[1] = a
         ds[q] = s[q + 1]
@@ -114,7 +126,8 @@ def _rhs(s, yb, p, codes, poff, soff, ds):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _simulate_one(yb, dt, p, codes, poff, soff, n_states, n_sub, out_acc, out_z, out_v):
+def _simulate_one(yb, dt, p, codes, poff, soff, n_states, n_sub, out_acc, out_z, out_v,
+                  force_input):
     """Integrate one particle from rest; returns False if the state blew up."""
     s = np.zeros(n_states)
     k1 = np.zeros(n_states)
@@ -124,7 +137,7 @@ def _simulate_one(yb, dt, p, codes, poff, soff, n_states, n_sub, out_acc, out_z,
     tmp = np.zeros(n_states)
     h = dt / n_sub
     n = yb.shape[0]
-    out_acc[0] = _rhs(s, yb[0], p, codes, poff, soff, k1)
+    out_acc[0] = _rhs(s, yb[0], p, codes, poff, soff, k1, force_input)
     out_z[0] = 0.0
     out_v[0] = 0.0
     for i in range(n - 1):
@@ -132,16 +145,16 @@ def _simulate_one(yb, dt, p, codes, poff, soff, n_states, n_sub, out_acc, out_z,
         dy = (yb[i + 1] - y0) / n_sub
         for sub in range(n_sub):
             ya = y0 + dy * sub
-            _rhs(s, ya, p, codes, poff, soff, k1)
+            _rhs(s, ya, p, codes, poff, soff, k1, force_input)
             for e in range(n_states):
                 tmp[e] = s[e] + 0.5 * h * k1[e]
-            _rhs(tmp, ya + 0.5 * dy, p, codes, poff, soff, k2)
+            _rhs(tmp, ya + 0.5 * dy, p, codes, poff, soff, k2, force_input)
             for e in range(n_states):
                 tmp[e] = s[e] + 0.5 * h * k2[e]
-            _rhs(tmp, ya + 0.5 * dy, p, codes, poff, soff, k3)
+            _rhs(tmp, ya + 0.5 * dy, p, codes, poff, soff, k3, force_input)
             for e in range(n_states):
                 tmp[e] = s[e] + h * k3[e]
-            _rhs(tmp, ya + dy, p, codes, poff, soff, k4)
+            _rhs(tmp, ya + dy, p, codes, poff, soff, k4, force_input)
             for e in range(n_states):
                 s[e] += h / 6.0 * (k1[e] + 2.0 * k2[e] + 2.0 * k3[e] + k4[e])
         ok = True
@@ -150,17 +163,18 @@ def _simulate_one(yb, dt, p, codes, poff, soff, n_states, n_sub, out_acc, out_z,
                 ok = False
         if not ok:
             return False
-        out_acc[i + 1] = _rhs(s, yb[i + 1], p, codes, poff, soff, k1)
+        out_acc[i + 1] = _rhs(s, yb[i + 1], p, codes, poff, soff, k1, force_input)
         out_z[i + 1] = s[0]
         out_v[i + 1] = s[1]
     return True
 
 
 @nb.njit(cache=True, parallel=True, error_model="numpy")
-def _simulate_batch(yb, dt, params, codes, poff, soff, n_states, n_sub, acc, zz, vv, ok):
+def _simulate_batch(yb, dt, params, codes, poff, soff, n_states, n_sub, acc, zz, vv, ok,
+                    force_input):
     for i in nb.prange(params.shape[0]):
         ok[i] = _simulate_one(yb, dt, params[i], codes, poff, soff, n_states, n_sub[i],
-                              acc[i], zz[i], vv[i])
+                              acc[i], zz[i], vv[i], force_input)
 
 
 @dataclass
@@ -183,9 +197,11 @@ def substeps(layout: Layout, params: np.ndarray, dt: float) -> np.ndarray:
 
 
 def simulate(layout: Layout, params: np.ndarray, base_acc: np.ndarray, dt: float,
-             n_substeps: int | np.ndarray | None = None) -> Simulation:
+             n_substeps: int | np.ndarray | None = None, force_input: bool = False) -> Simulation:
     """Relative response to the base acceleration ``base_acc`` (m/s^2) sampled every ``dt`` s.
 
+    With ``force_input`` the input is a force on the mass (N) instead, the base fixed; the
+    response is then relative to ground.
     ``params`` is (particles, len(layout.parameter_names)) in the layout's order, or one vector.
     ``n_substeps`` overrides the automatic choice (used to verify convergence).
     """
@@ -206,7 +222,7 @@ def simulate(layout: Layout, params: np.ndarray, base_acc: np.ndarray, dt: float
     valid = np.all(np.isfinite(p), axis=1)
     _simulate_batch(yb, float(dt), np.where(valid[:, None], p, 0.0), layout.codes,
                     layout.param_offsets, layout.state_offsets, layout.n_states, n_sub,
-                    acc, zz, vv, ok)
+                    acc, zz, vv, ok, bool(force_input))
     ok &= valid & np.all(np.isfinite(acc), axis=1)
     acc[~ok] = np.nan
     return Simulation(acc, zz, vv, ok, n_sub)

@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from harvester import paper
-from harvester.initial import DampingFit, StaticFrictionEstimate
+from harvester.initial import DampingFit, DampingSummary, StaticFrictionEstimate
 
 #: Columns of every comparison table, in order.
 COLUMNS: list[str] = ["parameter", "value", "unit", "paper", "truth"]
@@ -46,7 +46,7 @@ def rig_truth(config_rig: Mapping[str, Any]) -> dict[str, float]:
             "c_m": float(config_rig["c_m"])}
 
 
-def table1(static: StaticFrictionEstimate, damping: DampingFit,
+def table1(static: StaticFrictionEstimate, damping: DampingFit | DampingSummary,
            config_rig: Mapping[str, Any]) -> pd.DataFrame:
     """Table 1, initial parameter estimates: M, m, k (known, config ``rig``), F_c, c_m.
 
@@ -58,7 +58,7 @@ def table1(static: StaticFrictionEstimate, damping: DampingFit,
     return compare_table(ours, paper.TABLE1, rig_truth(config_rig), paper.TABLE1_UNITS)
 
 
-def table1_notes(static: StaticFrictionEstimate, damping: DampingFit,
+def table1_notes(static: StaticFrictionEstimate, damping: DampingFit | DampingSummary,
                  config_rig: Mapping[str, Any]) -> list[str]:
     """Footnotes of the rendered Table 1 (the CSV holds only the five columns)."""
     friction = config_rig["friction"]
@@ -104,21 +104,27 @@ def render_table(df: pd.DataFrame, title: str, notes: Sequence[str] = ()) -> str
 def write_table_png(df: pd.DataFrame, path: str | Path, title: str,
                     notes: Sequence[str] = ()) -> None:
     """The table as a PNG image (matplotlib), with its notes and the simulated footnote."""
+    import textwrap
+
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     cells = [[_fmt(x) for x in row] for row in df.itertuples(index=False)]
-    all_notes = [*notes, SIMULATED_NOTE]
-    height = 0.6 + 0.3 * (len(cells) + 1) + 0.45 * len(all_notes)
-    fig, ax = plt.subplots(figsize=(8.0, height))
-    ax.axis("off")
-    ax.set_title(title, fontsize=10)
-    table = ax.table(cellText=cells, colLabels=list(df.columns), loc="upper center",
-                     cellLoc="center")
+    lines = [textwrap.fill(f"{i}. {n}", width=120, subsequent_indent="   ")
+             for i, n in enumerate([*notes, SIMULATED_NOTE], start=1)]
+    n_note_lines = sum(line.count("\n") + 1 for line in lines)
+    table_h, notes_h = 0.28 * (len(cells) + 1) + 0.4, 0.16 * n_note_lines + 0.1
+    fig, (ax_t, ax_n) = plt.subplots(2, 1, figsize=(8.5, table_h + notes_h),
+                                     gridspec_kw={"height_ratios": [table_h, notes_h]})
+    for ax in (ax_t, ax_n):
+        ax.axis("off")
+    ax_t.set_title(title, fontsize=10)
+    table = ax_t.table(cellText=cells, colLabels=list(df.columns), loc="center",
+                       cellLoc="center", bbox=(0.0, 0.0, 1.0, 1.0))
     table.auto_set_font_size(False)
     table.set_fontsize(9)
-    fig.text(0.02, 0.02, "\n".join(f"{i}. {n}" for i, n in enumerate(all_notes, 1)),
-             fontsize=6.5, va="bottom", wrap=True)
+    ax_n.text(0.0, 1.0, "\n".join(lines), fontsize=7, va="top", ha="left",
+              transform=ax_n.transAxes)
     fig.savefig(path, dpi=150, bbox_inches="tight")
     plt.close(fig)

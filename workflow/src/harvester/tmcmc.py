@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import logging
 import time
+import warnings
 from collections.abc import Callable, Sequence
 
 import arviz as az
@@ -68,10 +69,12 @@ from scipy.special import logsumexp
 __all__ = [
     "TMCMC",
     "TMCMCError",
+    "compile_population_logp",
     "log_evidence",
     "next_beta",
     "plausibility_log_weights",
     "run_tmcmc",
+    "tidy_sample_stats",
     "weighted_covariance",
     "weights_cov",
 ]
@@ -242,7 +245,9 @@ class TMCMC(SMC_KERNEL):
         Multinomial is Ching & Chen's scheme; systematic has lower variance.
     log : logging.Logger or callable(str) or None, default None
         Where the per-stage progress line goes; None means the logger ``harvester.tmcmc`` at
-        INFO. A callable must be picklable by cloudpickle if ``cores > 1``.
+        INFO. A callable must be picklable by cloudpickle if ``cores > 1``. The chain number in
+        the line is right when chains run sequentially (``cores=1``); with parallel chains each
+        process reports chain 0.
     **kwargs
         Passed to `pymc.smc.kernels.SMC_KERNEL` (``draws``, ``model``, ``random_seed``,
         ``compile_kwargs``; ``threshold`` is not used by TMCMC).
@@ -534,18 +539,21 @@ def run_tmcmc(
     rates, likelihood evaluations and wall times; numeric only, so it can be saved to netCDF.
     """
     start = time.perf_counter()
-    idata = pm.sample_smc(
-        draws=draws,
-        kernel=TMCMC,
-        model=model,
-        chains=chains,
-        cores=cores,
-        random_seed=seed,
-        progressbar=progressbar,
-        compute_convergence_checks=False,
-        idata_kwargs=idata_kwargs,
-        **kernel_kwargs,
-    )
+    with warnings.catch_warnings():
+        # PyMC packs SMC stats as (1 chain, n chains) arrays; tidy_sample_stats redoes them.
+        warnings.filterwarnings("ignore", message="More chains", category=UserWarning)
+        idata = pm.sample_smc(
+            draws=draws,
+            kernel=TMCMC,
+            model=model,
+            chains=chains,
+            cores=cores,
+            random_seed=seed,
+            progressbar=progressbar,
+            compute_convergence_checks=False,
+            idata_kwargs=idata_kwargs,
+            **kernel_kwargs,
+        )
     wall_time = time.perf_counter() - start
     idata.sample_stats = tidy_sample_stats(idata.sample_stats, chains, wall_time)
     return idata

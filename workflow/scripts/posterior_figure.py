@@ -1,0 +1,18 @@
+"""Rule posterior_figure: Figures 6 and 8 (pairwise posterior samples)."""
+
+import arviz as az
+
+from harvester import paper
+from harvester.figures_posterior import pair_plot
+from harvester.posterior import parameter_names, samples
+from harvester.posterior import posterior_truth
+from harvester.runlog import rule_log
+
+with rule_log(snakemake) as log:  # noqa: F821
+    sm = snakemake  # noqa: F821
+    idata = az.from_netcdf(sm.input.posterior)
+    names = parameter_names(idata)
+    model = sm.wildcards.model
+    pair_plot(samples(idata, names), names, sm.output[0],
+              f"Posterior samples, {model} model (TMCMC, {idata.posterior.sizes['chain']} chains)",
+              paper=paper.POSTERIOR_MEANS.get(model), truth=posterior_truth(sm.params.rig, model))

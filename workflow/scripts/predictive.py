@@ -1,0 +1,23 @@
+"""Rule predictive: posterior predictive ensemble of a model for a record (training or unseen)."""
+
+import arviz as az
+
+from harvester.daq import read_recording
+from harvester.fileio import read_json
+from harvester.identify import make_problem, posterior_theta
+from harvester.predictive import posterior_predictive, save_band, thin
+from harvester.runlog import rule_log
+
+with rule_log(snakemake) as log:  # noqa: F821
+    sm = snakemake  # noqa: F821
+    rec = read_recording(sm.input.data)
+    idata = az.from_netcdf(sm.input.posterior)
+    problem = make_problem(rec, idata.posterior.attrs["model"], read_json(sm.input.priors)["known"])
+    theta = thin(posterior_theta(idata), sm.params.predictive["samples"], sm.params.predictive["seed"])
+    start = sm.params.lead_in
+    stop = len(rec) if sm.params.samples is None else start + sm.params.samples
+    band = posterior_predictive(problem, theta, rec["base_acc"].to_numpy(), rec["time"].to_numpy())
+    band.time, band.responses = band.time[start:stop], band.responses[:, start:stop]
+    save_band(sm.output[0], band, rec["rel_acc"].to_numpy()[start:stop], sm.wildcards.model,
+              "training" if sm.wildcards.record == "training" else "unseen")
+    log.info("%d posterior samples simulated over %d samples", len(theta), stop - start)

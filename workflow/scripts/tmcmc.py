@@ -1,0 +1,19 @@
+"""Rule tmcmc: posterior and evidence of one model structure (netCDF)."""
+
+from harvester.fileio import atomic_path, read_json
+from harvester.identify import TMCMCSettings, identify, make_problem
+from harvester.priors import PriorSpec
+from harvester.daq import read_recording
+from harvester.runlog import rule_log
+
+with rule_log(snakemake) as log:  # noqa: F821
+    sm = snakemake  # noqa: F821
+    prior_file = read_json(sm.input.priors)
+    priors = {n: PriorSpec(**p) for n, p in prior_file["priors"].items()}
+    start = sm.params.lead_in
+    problem = make_problem(read_recording(sm.input.data), sm.wildcards.model, prior_file["known"],
+                           window=(start, start + sm.params.samples))
+    idata = identify(problem, priors, TMCMCSettings.from_config(sm.params.tmcmc))
+    with atomic_path(sm.output[0]) as tmp:
+        idata.to_netcdf(str(tmp))
+    log.info("log evidence per chain: %s", idata.sample_stats["log_evidence"].values)
