@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 
@@ -12,6 +11,7 @@ import pytest
 import yaml
 
 from harvester import daq, rig
+from harvester.dataset import make_raw_data
 from harvester.errors import DataError
 
 ROOT = Path(__file__).parents[1]
@@ -332,17 +332,8 @@ def test_byte_order_mark_is_ignored(tmp_path) -> None:
     assert list(daq.read_recording(tmp_path / "r.csv").columns) == list(daq.RECORDING_COLUMNS)
 
 
-def load_script():
-    spec = importlib.util.spec_from_file_location(
-        "make_raw_data", ROOT / "workflow" / "scripts" / "make_raw_data.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-@pytest.mark.skipif(not (RAW / "SHA256SUMS").exists(), reason="data/raw not generated")
-def test_script_regenerates_committed_data_bit_for_bit(tmp_path) -> None:
-    written = load_script().make_raw_data(CONFIG, tmp_path)
+def test_committed_data_regenerates_bit_for_bit(tmp_path) -> None:
+    written = make_raw_data(CONFIG, tmp_path)
     listed = {line.split()[1] for line in (RAW / "SHA256SUMS").read_text().splitlines()}
     assert {p.name for p in written} == listed | {"SHA256SUMS"}
     assert (tmp_path / "SHA256SUMS").read_bytes() == (RAW / "SHA256SUMS").read_bytes()

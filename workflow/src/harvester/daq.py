@@ -13,8 +13,10 @@ Static friction test (eqs. 4-5): ``static_friction.csv`` with ``repeat,direction
 (direction ``down`` or ``up``; positions downward-positive, m) and ``static_friction.json``.
 
 Converted recording (also the input of ``harvester diagnose``): CSV with ``time`` (s),
-``base_acc`` (y'') and ``rel_acc`` (z'' = x'' - y'', eq. 1), m/s^2, plus optional extra
-numeric columns.
+one input column, ``base_acc`` (y'', m/s^2) or ``force`` (N), and one output column,
+``rel_acc`` (z'' = x'' - y'', eq. 1, m/s^2) or ``rel_disp`` (z, m), plus optional extra numeric
+columns. The column names declare the kinds (``harvester.recording``); the virtual rig's
+recordings are ``time, base_acc, rel_acc``.
 
 Every reader raises :class:`~harvester.errors.DataError` naming the file, the 1-based line
 (the header is line 1) and the column. Every writer is atomic (temporary file + rename).
@@ -36,12 +38,13 @@ import pandas as pd
 
 from harvester.errors import DataError
 from harvester.fileio import atomic_path
+from harvester.recording import check_plausible, recording_kinds
 
 #: Standard gravity (m/s^2) used to convert g to m/s^2.
 G = 9.80665
 #: Raw channels and what they measure.
 CHANNEL_QUANTITIES: dict[str, str] = {"ai0": "base_acceleration", "ai1": "mass_acceleration"}
-#: Converted-recording columns that must be present.
+#: Columns of the virtual rig's converted recordings (other kinds: ``harvester.recording``).
 RECORDING_COLUMNS: tuple[str, ...] = ("time", "base_acc", "rel_acc")
 #: Fewest samples a converted recording may hold.
 MIN_SAMPLES = 64
@@ -128,11 +131,15 @@ def write_static_test(df: pd.DataFrame, csv_path: str | Path, json_path: str | P
 
 
 def write_recording(df: pd.DataFrame, path: str | Path) -> None:
-    """Write a converted recording: time (%.9f s), base_acc, rel_acc, extras (%.9g m/s^2)."""
-    missing = [c for c in RECORDING_COLUMNS if c not in df.columns]
-    if missing:
-        raise DataError(path, f"cannot write: missing column(s) {missing}")
-    cols = [*RECORDING_COLUMNS, *(c for c in df.columns if c not in RECORDING_COLUMNS)]
+    """Write a converted recording: time (%.9f s), input, output, extras (%.9g, SI units).
+
+    The input column is ``base_acc`` or ``force``, the output ``rel_acc`` or ``rel_disp``.
+    """
+    if "time" not in df.columns:
+        raise DataError(path, "cannot write: missing column(s) ['time']")
+    kinds = recording_kinds(df.columns, path)
+    first = ["time", kinds.input_kind, kinds.output_kind]
+    cols = [*first, *(c for c in df.columns if c not in first)]
     _write_text(Path(path), _csv_text(df[cols], ["%.9f"] + ["%.9g"] * (len(cols) - 1)))
 
 
@@ -372,22 +379,26 @@ def to_accelerations(df: pd.DataFrame, meta: Mapping[str, Any]) -> pd.DataFrame:
 
 
 def read_recording(path: str | Path) -> pd.DataFrame:
-    """Read a converted recording (time, base_acc, rel_acc in s and m/s^2, extras allowed).
+    """Read a converted recording: time (s), one input and one output column, extras allowed.
 
-    Every column must be numeric with no NaN or empty rows, the time base uniform (relative
-    tolerance 1e-6 plus the rounding of the written decimals) and there must be at least
-    64 samples.
+    Input ``base_acc`` (m/s^2) or ``force`` (N); output ``rel_acc`` (m/s^2) or ``rel_disp`` (m)
+    (``harvester.recording.recording_kinds`` tells which from the columns). Every column must
+    be numeric with no NaN or empty rows, the time base uniform (relative tolerance 1e-6 plus
+    the rounding of the written decimals), there must be at least 64 samples, and a column
+    in another unit (a header ``rel_disp_mm``, an acceleration with gravity left in, a
+    displacement in mm) is reported (``harvester.recording.check_plausible``).
     """
     path = Path(path)
     header, rows, lines = _read_rows(path)
-    for name in RECORDING_COLUMNS:
-        if name not in header:
-            raise DataError(path, f"missing column (need {', '.join(RECORDING_COLUMNS)})",
-                            line=1, column=name)
+    if "time" not in header:
+        raise DataError(path, "missing column (need time, an input and an output column)",
+                        line=1, column="time")
+    kinds = recording_kinds(header, path)
     df = _numeric_table(path, header, rows, lines)
     if len(df) < MIN_SAMPLES:
         raise DataError(path, f"{len(df)} samples; at least {MIN_SAMPLES} are needed")
     _uniform_time(path, df, header, rows, lines)
+    check_plausible(df, kinds, path)
     return df
 
 

@@ -1,9 +1,16 @@
 """The identification problem: data, a model structure and the Gaussian likelihood of eqs. (8)-(10).
 
-Each sample of the relative acceleration is modelled as N(z''_hat_i(theta), sigma^2),
-independent (eq. 9), so log L = -N/2 log(2 pi sigma^2) - sum_i r_i^2 / (2 sigma^2), eq. (10),
-with sigma identified alongside the physical parameters. The model is simulated from the start
-of the record (from rest) and the likelihood uses the samples in ``window``.
+Each used sample of the measured output is modelled as N(y_hat_i(theta), sigma^2), independent
+(eq. 9), so log L = -N/2 log(2 pi sigma^2) - sum_i r_i^2 / (2 sigma^2), eq. (10), with sigma
+identified alongside the physical parameters. The model is simulated from the start of the
+record (from rest) and the likelihood uses every ``stride``-th sample in ``window``.
+
+Input and output kinds (``harvester.recording``): the model is driven by the base acceleration
+(``base_acc``, m/s^2, the paper's case) or by a force on the mass (``force``, N, base fixed,
+so m does not enter eq. 1), and predicts the relative acceleration (``rel_acc``, m/s^2, the
+paper's eq. 8) or the relative displacement (``rel_disp``, m). A displacement is compared
+from the first sample on: the model starts at rest at z = 0, the measured displacement at
+``output[0]``, and the prediction is ``output[0] + z(t)``.
 """
 
 from __future__ import annotations
@@ -12,38 +19,73 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from harvester.recording import INPUT_KINDS, OUTPUT_KINDS
 from harvester.simulate import Simulation, simulate
 from harvester.structures import ModelStructure
 
 
 @dataclass
 class Problem:
-    """What the sampler needs: theta = (free parameters..., sigma) -> log-likelihood."""
+    """What the sampler needs: theta = (free parameters..., sigma) -> log-likelihood.
+
+    ``input`` is the whole record of the input of kind ``input_kind`` ('base_acc' in m/s^2 or
+    'force' in N), ``output`` the measured output of kind ``output_kind`` ('rel_acc' in
+    m/s^2 or 'rel_disp' in m). ``base_acc`` and ``rel_acc`` are the paper-case names of the
+    same arrays (kept for the study's scripts).
+    """
 
     structure: ModelStructure
-    base_acc: np.ndarray  # y'' (m/s^2), whole record
-    rel_acc: np.ndarray  # measured z'' (m/s^2), whole record
+    input: np.ndarray  # whole record, unit of input_kind
+    output: np.ndarray  # measured, whole record, unit of output_kind
     dt: float  # s
     known: dict[str, float]  # values of the layout parameters that are not identified
     window: tuple[int, int] | None = None  # samples [start, stop) used by the likelihood
+    input_kind: str = "base_acc"
+    output_kind: str = "rel_acc"
+    stride: int = 1  # the likelihood uses every stride-th sample of the window
     n_evaluations: int = field(default=0, init=False)
 
     def __post_init__(self) -> None:
-        self.base_acc = np.asarray(self.base_acc, dtype=float)
-        self.rel_acc = np.asarray(self.rel_acc, dtype=float)
-        if self.base_acc.shape != self.rel_acc.shape:
-            raise ValueError("base_acc and rel_acc differ in length")
+        self.input = np.asarray(self.input, dtype=float)
+        self.output = np.asarray(self.output, dtype=float)
+        self._check_kinds()
+        if self.input.shape != self.output.shape:
+            raise ValueError(f"{self.input_kind} and {self.output_kind} differ in length")
         layout = self.structure.layout
         missing = [n for n in layout.parameter_names
                    if n not in self.structure.free_parameters and n not in self.known]
         if missing:
             raise ValueError(f"no value for known parameters {missing} of {self.structure.name}")
-        start, stop = self.window or (0, len(self.rel_acc))
+        start, stop = self.window or (0, len(self.output))
         self.window = (int(start), int(stop))
-        if not 0 <= start < stop <= len(self.rel_acc):
-            raise ValueError(f"window {self.window} outside the record of {len(self.rel_acc)} samples")
+        if not 0 <= start < stop <= len(self.output):
+            raise ValueError(f"window {self.window} outside the record of {len(self.output)} samples")
+        self.stride = int(self.stride)
+        if self.stride < 1:
+            raise ValueError(f"stride must be a positive integer, got {self.stride}")
         self._free_idx = np.array([layout.index(n) for n in self.structure.free_parameters])
         self._template = np.array([self.known.get(n, np.nan) for n in layout.parameter_names])
+
+    def _check_kinds(self) -> None:
+        if self.input_kind not in INPUT_KINDS:
+            raise ValueError(f"input_kind must be one of {list(INPUT_KINDS)}, got {self.input_kind!r}")
+        if self.output_kind not in OUTPUT_KINDS:
+            raise ValueError(f"output_kind must be one of {list(OUTPUT_KINDS)}, "
+                             f"got {self.output_kind!r}")
+
+    # ---- paper-case names -------------------------------------------------------------------
+
+    @property
+    def base_acc(self) -> np.ndarray:
+        """The input record (the base acceleration in the paper's case)."""
+        return self.input
+
+    @property
+    def rel_acc(self) -> np.ndarray:
+        """The measured output record (the relative acceleration in the paper's case)."""
+        return self.output
+
+    # ---- data ---------------------------------------------------------------------------------
 
     @property
     def parameter_names(self) -> tuple[str, ...]:
@@ -51,12 +93,24 @@ class Problem:
         return self.structure.free_parameters + ("sigma",)
 
     @property
+    def samples(self) -> slice:
+        """The samples of the record the likelihood uses."""
+        return slice(self.window[0], self.window[1], self.stride)
+
+    @property
     def n_data(self) -> int:
-        return self.window[1] - self.window[0]
+        return len(range(*self.samples.indices(len(self.output))))
 
     @property
     def observed(self) -> np.ndarray:
-        return self.rel_acc[self.window[0]:self.window[1]]
+        return self.output[self.samples]
+
+    @property
+    def output_origin(self) -> float:
+        """Added to the simulated output: the first measured displacement (0 for rel_acc)."""
+        return float(self.output[0]) if self.output_kind == "rel_disp" else 0.0
+
+    # ---- model --------------------------------------------------------------------------------
 
     def layout_params(self, theta: np.ndarray) -> np.ndarray:
         """Full layout parameter matrix (particles, layout params) from theta (particles, P)."""
@@ -65,21 +119,46 @@ class Problem:
         full[:, self._free_idx] = theta[:, : len(self._free_idx)]
         return full
 
-    def simulate(self, theta: np.ndarray, base_acc: np.ndarray | None = None) -> Simulation:
-        """Simulated response for each row of theta, to the training or another base input."""
-        yb = self.base_acc if base_acc is None else base_acc
-        return simulate(self.structure.layout, self.layout_params(theta), yb, self.dt)
+    def simulate(self, theta: np.ndarray, input: np.ndarray | None = None, *,
+                 base_acc: np.ndarray | None = None) -> Simulation:
+        """Simulated response for each row of theta, to the training or another input.
+
+        ``base_acc`` is the paper-case name of ``input`` (either may be given).
+        """
+        u = self.input if input is None and base_acc is None else (
+            input if input is not None else base_acc)
+        return simulate(self.structure.layout, self.layout_params(theta), u, self.dt,
+                        force_input=self.input_kind == "force")
+
+    def predicted(self, sim: Simulation, origin: float | None = None) -> np.ndarray:
+        """The simulated output of this problem's kind (particles, samples), NaN where failed.
+
+        ``origin`` (default :attr:`output_origin`) is added to a displacement.
+        """
+        if self.output_kind == "rel_acc":
+            out = sim.rel_acc.copy()
+        else:
+            out = sim.rel_disp + (self.output_origin if origin is None else origin)
+        out[~sim.ok] = np.nan
+        return out
+
+    def predict(self, theta: np.ndarray, input: np.ndarray | None = None,
+                origin: float | None = None) -> np.ndarray:
+        """Predicted output (particles, samples) for each row of theta (NaN where failed).
+
+        For another input than the training one, give the displacement ``origin`` of that
+        record (its first measured sample) for a rel_disp output.
+        """
+        return self.predicted(self.simulate(theta, input), origin)
 
     def loglike(self, theta: np.ndarray) -> np.ndarray:
         """Log-likelihood, eq. (10), for each row of theta; -inf where simulation failed."""
         theta = np.atleast_2d(np.asarray(theta, dtype=float))
         self.n_evaluations += theta.shape[0]
         sigma = theta[:, -1]
-        sim = self.simulate(theta)
-        start, stop = self.window
-        r = sim.rel_acc[:, start:stop] - self.observed
+        r = self.predict(theta)[:, self.samples] - self.observed
         n = self.n_data
         with np.errstate(invalid="ignore", divide="ignore"):
             ll = -0.5 * n * np.log(2 * np.pi * sigma**2) - 0.5 * np.sum(r * r, axis=1) / sigma**2
-        ll[~sim.ok | ~(sigma > 0) | ~np.isfinite(ll)] = -np.inf
+        ll[~(sigma > 0) | ~np.isfinite(ll)] = -np.inf
         return ll

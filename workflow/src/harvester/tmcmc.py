@@ -241,6 +241,12 @@ class TMCMC(SMC_KERNEL):
         (Ching & Chen: 100 %). Smaller values give more, gentler stages.
     mcmc_steps : int, default 2
         Metropolis moves per particle per stage.
+    target_accept : float or None, default None
+        None keeps ``proposal_scale`` fixed (Ching & Chen). A value (e.g. 0.25) adapts the scale
+        after every stage, scale <- scale * exp(2 (acceptance - target_accept)), as in Betz,
+        Papaioannou and Straub (2016): with a fixed 0.2 the particles cannot follow a posterior
+        that lies far in the prior's tail (acceptance stays near 0.9 and the population
+        collapses before it arrives). The scale used is recorded per stage.
     resampling : {"multinomial", "systematic"}, default "multinomial"
         Multinomial is Ching & Chen's scheme; systematic has lower variance.
     log : logging.Logger or callable(str) or None, default None
@@ -267,6 +273,7 @@ class TMCMC(SMC_KERNEL):
         # counts evaluating the initial (prior) population.
         "n_evals": (int, []),
         "wall_time": (float, []),
+        "proposal_scale": (float, []),
     }
 
     def __init__(
@@ -275,6 +282,7 @@ class TMCMC(SMC_KERNEL):
         proposal_scale: float = 0.2,
         target_cov: float = 1.0,
         mcmc_steps: int = 2,
+        target_accept: float | None = None,
         resampling: str = "multinomial",
         log: logging.Logger | Callable[[str], None] | None = None,
         **kwargs,
@@ -288,7 +296,11 @@ class TMCMC(SMC_KERNEL):
         if resampling not in RESAMPLING_SCHEMES:
             raise ValueError(f"resampling must be one of {RESAMPLING_SCHEMES}, got {resampling!r}")
         super().__init__(*args, **kwargs)
+        if target_accept is not None and not 0.0 < target_accept < 1.0:
+            raise ValueError(f"target_accept must be in (0, 1) or None, got {target_accept}")
         self.proposal_scale = float(proposal_scale)
+        self.initial_scale = float(proposal_scale)
+        self.target_accept = target_accept
         self.target_cov = float(target_cov)
         self.mcmc_steps = int(mcmc_steps)
         self.resampling = resampling
@@ -305,6 +317,7 @@ class TMCMC(SMC_KERNEL):
         self.weights_cov = np.nan
         self.ess = np.nan
         self.acc_rate = np.nan
+        self.scale_used = np.nan
         self.stage_particles: np.ndarray | None = None
         self.proposal_chol: np.ndarray | None = None
         self.n_evals = 0
@@ -328,6 +341,7 @@ class TMCMC(SMC_KERNEL):
         """
         self.chain += 1
         self._reset_stage_state()
+        self.proposal_scale = self.initial_scale
         init = self.start if self.start else self.initialize_population()
         population = [
             DictToArrayBijection.map({v.name: init[v.name][i] for v in self.variables}).data
@@ -418,6 +432,10 @@ class TMCMC(SMC_KERNEL):
             self.tempered_posterior_logp[accept] = proposal_logp[accept]
             accepted += int(accept.sum())
         self.acc_rate = accepted / (n * self.mcmc_steps)
+        self.scale_used = self.proposal_scale
+        if self.target_accept is not None:
+            factor = np.exp(2.0 * (self.acc_rate - self.target_accept))
+            self.proposal_scale = float(np.clip(self.proposal_scale * factor, 1e-3, 5.0))
 
     def sample_stats(self) -> SMCStats:
         now = time.perf_counter()
@@ -430,13 +448,14 @@ class TMCMC(SMC_KERNEL):
             "ess": self.ess,
             "n_evals": self.n_evals,
             "wall_time": now - self._stage_clock,
+            "proposal_scale": self.scale_used,
         }
         self.n_evals = 0
         self._stage_clock = now
         self._say(
             f"TMCMC chain {self.chain} stage {self.iteration}: beta={self.beta:.4g} "
             f"(cov(w)={self.weights_cov:.2f}, ESS={self.ess:.0f}/{self.draws}), "
-            f"accept={self.acc_rate:.2f}, log_evidence={self.log_marginal_likelihood:.3f}, "
+            f"accept={self.acc_rate:.2f} (scale {self.scale_used:.3g}), log_evidence={self.log_marginal_likelihood:.3f}, "
             f"{stats['n_evals']} evals in {stats['wall_time']:.2f} s"
         )
         return stats
@@ -446,9 +465,10 @@ class TMCMC(SMC_KERNEL):
             "_n_draws": self.draws,
             "_n_tune": self.mcmc_steps,
             "kernel": "TMCMC",
-            "proposal_scale": self.proposal_scale,
+            "proposal_scale": self.initial_scale,
             "target_cov": self.target_cov,
             "mcmc_steps": self.mcmc_steps,
+            "target_accept": -1.0 if self.target_accept is None else self.target_accept,
             "resampling": self.resampling,
         }
 
@@ -467,7 +487,7 @@ class TMCMC(SMC_KERNEL):
 
 #: Per-stage statistics copied into run_tmcmc's sample_stats, with dims (chain, stage).
 STAGE_STATS = ("beta", "accept_rate", "log_mean_weight", "weights_cov", "ess", "n_evals",
-               "wall_time")
+               "wall_time", "proposal_scale")
 
 
 def _per_chain_stage_lists(values, chains: int) -> list[np.ndarray]:
