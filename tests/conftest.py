@@ -29,8 +29,8 @@ def small_config() -> dict:
 
 def run_snakemake(workdir: Path, *targets: str, check: bool = True) -> subprocess.CompletedProcess:
     """Run the repository's Snakefile in ``workdir`` (its config.yaml) for ``targets``."""
-    cmd = [str(SNAKEMAKE), "-s", str(ROOT / "Snakefile"), "-d", str(workdir), "--configfile",
-           str(workdir / "config.yaml"), "--cores", "2", "--quiet", "rules", *targets]
+    cmd = [str(SNAKEMAKE), *targets, "-s", str(ROOT / "Snakefile"), "-d", str(workdir),
+           "--configfile", str(workdir / "config.yaml"), "--cores", "2", "--quiet", "rules"]
     env = dict(os.environ, PYTHONWARNINGS="ignore")
     proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=1200)
     if check and proc.returncode != 0:

@@ -108,9 +108,10 @@ def static_test_metadata(rig: Mapping[str, Any]) -> dict[str, Any]:
         "simulated": True, "source": SOURCE,
         "test": "static friction, Green et al. (2015) eqs. (4)-(5); device vertical",
         "columns": {"repeat": "repeat number, from 1",
-                    "direction": "'down': mass displaced downwards, released, rest position x1; "
-                                 "'up': displaced upwards, rest position x2",
-                    "position_m": "rest position read off the scale"},
+                    "direction": "'down': largest downward displacement at which the mass, "
+                                 "held and let go, stays put (x1); 'up': likewise upwards (x2)",
+                    "position_m": "that position, read off the scale"},
+        "procedure": {"hold_s": float(st["hold_s"]), "step_m": float(st["step_m"])},
         "position": {"unit": "m", "positive": "down",
                      "datum": "frictionless equilibrium (spring extended by m g / k)"},
         "friction_from_positions": "F_s = k (x1 - x2) / 2 (the paper writes 2 F_c = "

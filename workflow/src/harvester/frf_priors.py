@@ -71,7 +71,8 @@ def linear_frf(freqs_hz: ArrayLike, M: float, m: float, k: float, c: float,
     """FRF of the linear eq. (1) from the input to the output of ``kinds`` (SI units)."""
     w = 2.0 * np.pi * np.asarray(freqs_hz, dtype=float)
     scale = 1.0 if kinds.input_kind == "force" else m
-    return scale * dynamic_stiffness_factor(freqs_hz, kinds) / (k - M * w**2 + 1j * c * w)
+    with np.errstate(divide="ignore", invalid="ignore"):  # w = 0 with k = 0: a free mass
+        return scale * dynamic_stiffness_factor(freqs_hz, kinds) / (k - M * w**2 + 1j * c * w)
 
 
 def measured_frf(u: ArrayLike, y: ArrayLike, fs: float, segment_s: float = SEGMENT_S,
@@ -124,7 +125,8 @@ class FrfFit:
 
     def summary(self) -> dict:
         """Scalars for JSON."""
-        return {"values": self.values, "fitted": list(self.fitted), "residual": self.residual,
+        values = {k: (v if np.isfinite(v) else None) for k, v in self.values.items()}
+        return {"values": values, "fitted": list(self.fitted), "residual": self.residual,
                 "input_kind": self.kinds.input_kind, "output_kind": self.kinds.output_kind,
                 "band_hz": list(self.band_hz)}
 
@@ -145,8 +147,8 @@ def fit_linear_frf(recording: pd.DataFrame, known: Mapping[str, float],
                    source: str = "<recording>", check_units: bool = True) -> FrfFit:
     """Fit the linear eq. (1) to the recording's FRF over ``band_hz``.
 
-    ``known``: the sidecar's values (M, m, k, c_m). For a force input M, k and c are all
-    fitted, whatever is known, so that a known M can be checked against the data for a unit
+    ``known``: the sidecar's values (M, m, k, c_m). For a force input a known k or c_m is
+    held and M is always fitted, so that a known M can be checked against the data for a unit
     slip (:func:`harvester.recording.check_scale`: a ratio of g or 1000). For a base input
     the fit gives M/m, k/m, c/m; a known parameter sets the scale (M first, then m, k, c_m),
     and an m/M above 1 (impossible) or off the known m/M by a factor g is reported.
@@ -168,8 +170,14 @@ def fit_linear_frf(recording: pd.DataFrame, known: Mapping[str, float],
     wb = 2.0 * np.pi * fb
     g = dynamic_stiffness_factor(fb, kinds)
 
+    # a force input's known k and c_m are held (M is always fitted: the unit check needs it)
+    hold_k = known.get("k") if kinds.input_kind == "force" else None
+    hold_c = known.get("c_m") if kinds.input_kind == "force" else None
+
     def unpack(x: NDArray) -> tuple[float, float, float]:
-        return x[0] * scale[0], np.exp(x[1]) * scale[1], np.exp(x[2]) * scale[2]
+        k = x[0] * scale[0] if hold_k is None else float(hold_k)
+        c = np.exp(x[2]) * scale[2] if hold_c is None else float(hold_c)
+        return k, np.exp(x[1]) * scale[1], c
 
     def residuals(x: NDArray) -> NDArray:
         k, M, c = unpack(x)
@@ -183,7 +191,7 @@ def fit_linear_frf(recording: pd.DataFrame, known: Mapping[str, float],
     resid = float(np.sqrt(np.sum(sol.fun**2) / (2.0 * np.sum(weight))))
 
     values = {"M": M, "m": np.nan, "k": k, "c_m": c}
-    fitted = ("M", "k", "c_m")
+    fitted = ("M",) + (("k",) if hold_k is None else ()) + (("c_m",) if hold_c is None else ())
     if kinds.input_kind == "base_acc":
         # the fit gives ratios to m: scale by a known parameter
         ratios = {"M": M, "m": 1.0, "k": k, "c_m": c}

@@ -8,13 +8,14 @@ record (from rest) and the likelihood uses every ``stride``-th sample in ``windo
 Input and output kinds (``harvester.recording``): the model is driven by the base acceleration
 (``base_acc``, m/s^2, the paper's case) or by a force on the mass (``force``, N, base fixed,
 so m does not enter eq. 1), and predicts the relative acceleration (``rel_acc``, m/s^2, the
-paper's eq. 8) or the relative displacement (``rel_disp``, m). A displacement is compared
-from the first sample on: the model starts at rest at z = 0, the measured displacement at
-``output[0]``, and the prediction is ``output[0] + z(t)``.
+paper's eq. 8) or the relative displacement (``rel_disp``, m). The model starts at rest at
+z = 0: a measured displacement is zero at the rest position the record starts from (the
+recording format says so, ``harvester.recording``).
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -43,6 +44,7 @@ class Problem:
     input_kind: str = "base_acc"
     output_kind: str = "rel_acc"
     stride: int = 1  # the likelihood uses every stride-th sample of the window
+    temper: float = 1.0  # power of the likelihood: eq. (10) x temper (1 / tau for correlated noise)
     n_evaluations: int = field(default=0, init=False)
 
     def __post_init__(self) -> None:
@@ -63,6 +65,8 @@ class Problem:
         self.stride = int(self.stride)
         if self.stride < 1:
             raise ValueError(f"stride must be a positive integer, got {self.stride}")
+        if not 0.0 < self.temper <= 1.0:
+            raise ValueError(f"temper must be in (0, 1], got {self.temper}")
         self._free_idx = np.array([layout.index(n) for n in self.structure.free_parameters])
         self._template = np.array([self.known.get(n, np.nan) for n in layout.parameter_names])
 
@@ -105,11 +109,6 @@ class Problem:
     def observed(self) -> np.ndarray:
         return self.output[self.samples]
 
-    @property
-    def output_origin(self) -> float:
-        """Added to the simulated output: the first measured displacement (0 for rel_acc)."""
-        return float(self.output[0]) if self.output_kind == "rel_disp" else 0.0
-
     # ---- model --------------------------------------------------------------------------------
 
     def layout_params(self, theta: np.ndarray) -> np.ndarray:
@@ -130,29 +129,27 @@ class Problem:
         return simulate(self.structure.layout, self.layout_params(theta), u, self.dt,
                         force_input=self.input_kind == "force")
 
-    def predicted(self, sim: Simulation, origin: float | None = None) -> np.ndarray:
-        """The simulated output of this problem's kind (particles, samples), NaN where failed.
-
-        ``origin`` (default :attr:`output_origin`) is added to a displacement.
-        """
-        if self.output_kind == "rel_acc":
-            out = sim.rel_acc.copy()
-        else:
-            out = sim.rel_disp + (self.output_origin if origin is None else origin)
+    def output_of(self, sim: Simulation) -> np.ndarray:
+        """The simulated output of this problem's kind (particles, samples), NaN where failed."""
+        out = (sim.rel_acc if self.output_kind == "rel_acc" else sim.rel_disp).copy()
         out[~sim.ok] = np.nan
         return out
 
-    def predict(self, theta: np.ndarray, input: np.ndarray | None = None,
-                origin: float | None = None) -> np.ndarray:
-        """Predicted output (particles, samples) for each row of theta (NaN where failed).
+    def predict(self, theta: np.ndarray, input: np.ndarray | None = None) -> np.ndarray:
+        """Predicted output (particles, samples) for each row of theta (NaN where failed),
+        for the training input or another one."""
+        return self.output_of(self.simulate(theta, input))
 
-        For another input than the training one, give the displacement ``origin`` of that
-        record (its first measured sample) for a rel_disp output.
-        """
-        return self.predicted(self.simulate(theta, input), origin)
+    def replace(self, **changes) -> "Problem":
+        """A copy with some fields changed (same class, kinds, stride; e.g. ``temper=0.1``)."""
+        return dataclasses.replace(self, **changes)
 
     def loglike(self, theta: np.ndarray) -> np.ndarray:
-        """Log-likelihood, eq. (10), for each row of theta; -inf where simulation failed."""
+        """Log-likelihood, eq. (10) x ``temper``, for each row of theta; -inf where simulation failed.
+
+        ``temper`` < 1 is the power likelihood L ** temper: with residuals correlated over
+        tau samples, temper = 1 / tau counts each independent piece of information once.
+        """
         theta = np.atleast_2d(np.asarray(theta, dtype=float))
         self.n_evaluations += theta.shape[0]
         sigma = theta[:, -1]
@@ -161,4 +158,4 @@ class Problem:
         with np.errstate(invalid="ignore", divide="ignore"):
             ll = -0.5 * n * np.log(2 * np.pi * sigma**2) - 0.5 * np.sum(r * r, axis=1) / sigma**2
         ll[~(sigma > 0) | ~np.isfinite(ll)] = -np.inf
-        return ll
+        return self.temper * ll if self.temper != 1.0 else ll

@@ -11,7 +11,7 @@ base_acc   m/s^2  input: base acceleration y'' (eq. 1 driven by -m y'')
 force      N      input: force on the mass, base fixed (eq. 1 driven by F; m unused)
 rel_acc    m/s^2  output: z'' = x'' - y'', the mass's acceleration relative to the base
 rel_disp   m      output: z, the mass's displacement relative to the base (to ground
-                  for a force input), measured from its position at the first sample
+                  for a force input), zero at the rest position the record starts from
 ========== ====== ===================================================================
 
 Exactly one input and one output column; other numeric columns are carried along unused.

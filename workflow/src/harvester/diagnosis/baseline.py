@@ -20,7 +20,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import optimize
+from scipy import optimize, signal
 
 from harvester.likelihood import Problem
 from harvester.priors import PriorSpec
@@ -30,28 +30,79 @@ log = logging.getLogger("harvester.diagnosis")
 
 
 @dataclass
-class TemperedProblem(Problem):
-    """:class:`~harvester.likelihood.Problem` whose log-likelihood is multiplied by ``temper``.
+class ChainProblem(Problem):
+    """:class:`~harvester.likelihood.Problem` with the measurement chain and a tempered eq. (10).
 
-    ``temper`` = lambda = 1 / tau (effective fraction of independent samples). With
-    ``temper = 1`` it is eq. (10) unchanged.
+    The recordings are zero-phase low-passed; the simulated z'' is not, and its content above
+    the cut-off (friction harmonics) has no counterpart in the data. So both the simulated and
+    the measured z'' go through the same zero-phase Butterworth low-pass (``lowpass_hz``,
+    ``filter_order``; None: no filter) before the residual is formed, and the log-likelihood
+    of eq. (10) is multiplied by ``temper`` = lambda. With ``lowpass_hz=None, temper=1`` it is
+    the study's likelihood unchanged.
     """
 
     temper: float = 1.0
+    lowpass_hz: float | None = None
+    filter_order: int = 8
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self._observed_chain = self.chain(self.rel_acc)[self.window[0]:self.window[1]]
+
+    def chain(self, x: np.ndarray) -> np.ndarray:
+        """The measurement chain's low-pass applied along the last axis (identity if None)."""
+        if self.lowpass_hz is None:
+            return np.asarray(x, dtype=float)
+        sos = signal.butter(self.filter_order, self.lowpass_hz, btype="low",
+                            fs=1.0 / self.dt, output="sos")
+        return signal.sosfiltfilt(sos, np.asarray(x, dtype=float), axis=-1)
+
+    @property
+    def observed(self) -> np.ndarray:
+        return self._observed_chain
+
+    def predicted(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(z'' through the chain over the whole record (N, n), ok (N,)) for rows of theta."""
+        sim = self.simulate(np.atleast_2d(theta))
+        acc = np.where(sim.ok[:, None], sim.rel_acc, 0.0)
+        out = self.chain(acc)
+        out[~sim.ok] = np.nan
+        return out, sim.ok
+
+    def residuals(self, theta: np.ndarray) -> np.ndarray:
+        """Measured minus predicted z'' over the window, both through the chain (N, n_data)."""
+        pred, _ = self.predicted(theta)
+        start, stop = self.window
+        return self.observed[None, :] - pred[:, start:stop]
 
     def loglike(self, theta: np.ndarray) -> np.ndarray:
-        return self.temper * super().loglike(theta)
+        theta = np.atleast_2d(np.asarray(theta, dtype=float))
+        self.n_evaluations += theta.shape[0]
+        sigma = theta[:, -1]
+        r = self.residuals(theta)
+        n = self.n_data
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ll = -0.5 * n * np.log(2 * np.pi * sigma**2) - 0.5 * np.sum(r * r, axis=1) / sigma**2
+        ll[~(sigma > 0) | ~np.isfinite(ll)] = -np.inf
+        return self.temper * ll
 
 
-def tempered(problem: Problem, temper: float) -> TemperedProblem:
-    """A copy of ``problem`` (same structure, data, window) with a tempered likelihood.
+#: Samples simulated beyond the window's end so that the zero-phase filter's end effect
+#: falls outside the window.
+CHAIN_PAD_S = 0.5
 
-    The copy's records end at the window's end: the simulation runs from rest at the first
-    sample, so samples after the window never change the likelihood and need not be simulated.
+
+def chain_problem(problem: Problem, temper: float = 1.0, lowpass_hz: float | None = None,
+                  filter_order: int = 8, structure=None) -> ChainProblem:
+    """A :class:`ChainProblem` on the data and window of ``problem`` (optionally another
+    structure), its records cut CHAIN_PAD_S after the window's end: the simulation runs from
+    rest at the first sample, so later samples never change the likelihood.
     """
     start, stop = problem.window
-    return TemperedProblem(problem.structure, problem.base_acc[:stop], problem.rel_acc[:stop],
-                           problem.dt, dict(problem.known), (start, stop), temper=float(temper))
+    end = min(len(problem.rel_acc), stop + int(round(CHAIN_PAD_S / problem.dt)))
+    return ChainProblem(structure or problem.structure, problem.base_acc[:end],
+                        problem.rel_acc[:end], problem.dt, dict(problem.known), (start, stop),
+                        temper=float(temper), lowpass_hz=lowpass_hz, filter_order=filter_order)
 
 
 def integrated_autocorrelation_time(x: np.ndarray, c: float = 5.0) -> float:
@@ -108,48 +159,44 @@ def _prior_arrays(problem: Problem, priors: Mapping[str, PriorSpec]):
     return mu, sd, lower
 
 
-def fit_map(problem: Problem, priors: Mapping[str, PriorSpec], temper: float = 1.0,
-            n_starts: int = 48, seed: int = 0) -> PointFit:
+def fit_map(problem: ChainProblem, priors: Mapping[str, PriorSpec], n_starts: int = 48,
+            seed: int = 0) -> PointFit:
     """Posterior mode of the free physical parameters, sigma profiled (sigma = RMS residual).
 
-    Minimises lambda * n/2 * log(sum r^2) + 1/2 sum ((theta - mu)/sd)^2 over theta >= lower
-    (truncated Gaussian priors), by trust-region least squares in prior-scaled coordinates,
-    started from the best of ``n_starts`` prior draws (and the prior mean) evaluated in one
-    batched simulation. Jacobians by forward differences, one batched simulation each.
+    Minimises lambda n/2 log(sum r^2) + 1/2 sum ((theta - mu)/sd)^2 over theta >= lower
+    (truncated Gaussian priors, lambda = ``problem.temper``, r through the measurement chain),
+    by trust-region least squares in prior-scaled coordinates, started from the best of
+    ``n_starts`` prior draws (and the prior mean) evaluated in one batched simulation.
+    Jacobians by forward differences, one batched simulation each.
     """
     mu, sd, lower = _prior_arrays(problem, priors)
+    temper = problem.temper
     p = len(mu)
-    start, stop = problem.window
-    y = problem.observed
     n = problem.n_data
     count = [0]
 
-    def simulate_u(us: np.ndarray) -> np.ndarray:
+    def resid_u(us: np.ndarray) -> np.ndarray:
         theta = np.column_stack([mu + us * sd, np.ones(len(us))])
         count[0] += len(us)
-        sim = problem.simulate(theta)
-        out = sim.rel_acc[:, start:stop]
-        out[~sim.ok] = np.nan
-        return out
+        return problem.residuals(theta)
 
     def objective_rows(us: np.ndarray) -> np.ndarray:
-        r = y[None, :] - simulate_u(us)
+        r = resid_u(us)
         with np.errstate(invalid="ignore"):
             val = 0.5 * temper * n * np.log(np.sum(r * r, axis=1)) + 0.5 * np.sum(us * us, axis=1)
         return np.where(np.isfinite(val), val, np.inf)
 
     u_low = np.where(np.isfinite(lower), (lower - mu) / sd, -np.inf)
     rng = np.random.default_rng(seed)
-    draws = rng.standard_normal((n_starts, p))
-    draws = np.maximum(draws, u_low + 1e-6)
+    draws = np.maximum(rng.standard_normal((n_starts, p)), u_low + 1e-6)
     candidates = np.vstack([np.maximum(np.zeros(p), u_low + 1e-6), draws])
     u0 = candidates[int(np.argmin(objective_rows(candidates)))]
 
-    # least squares form: [sqrt(lambda) r / s ; u], s the RMS residual at the current point
+    # least-squares form [sqrt(lambda) r / s ; u], s the RMS residual where sigma was profiled
     state: dict[str, float] = {}
 
     def residuals(u: np.ndarray) -> np.ndarray:
-        r = y - simulate_u(u[None, :])[0]
+        r = resid_u(u[None, :])[0]
         if not np.all(np.isfinite(r)):
             return np.full(n + p, 1e6)
         s = state.setdefault("s", float(np.sqrt(np.mean(r * r))))
@@ -157,10 +204,8 @@ def fit_map(problem: Problem, priors: Mapping[str, PriorSpec], temper: float = 1
 
     def jacobian(u: np.ndarray) -> np.ndarray:
         h = 1e-4 * np.maximum(1.0, np.abs(u))
-        us = np.vstack([u, u + np.diag(h)])
-        out = simulate_u(us)
-        s = state["s"]
-        jr = -(out[1:] - out[0]).T / h / s * np.sqrt(temper)
+        r = resid_u(np.vstack([u, u + np.diag(h)]))
+        jr = (r[1:] - r[0]).T / h * np.sqrt(temper) / state["s"]
         jr[~np.isfinite(jr)] = 0.0
         return np.vstack([jr, np.eye(p)])
 
@@ -175,18 +220,17 @@ def fit_map(problem: Problem, priors: Mapping[str, PriorSpec], temper: float = 1
         if moved < 1e-4:
             break
     theta_phys = mu + u * sd
-    full = problem.simulate(np.append(theta_phys, 1.0)).rel_acc[0]
-    residual = problem.rel_acc - full
-    sigma = float(np.sqrt(np.mean(residual[start:stop] ** 2)))
-    # Laplace covariance in theta: (lambda J^T J / sigma^2 + diag 1/sd^2)^-1
+    r = resid_u(u[None, :])[0]
+    sigma = float(np.sqrt(np.mean(r * r)))
+    # Laplace covariance: (lambda J^T J / sigma^2 + diag(1 / sd^2))^-1, J = d model / d theta
     state["s"] = sigma
-    ju = jacobian(u)[:n] / np.sqrt(temper) * sigma  # d(model)/du, m/s^2 per prior sd
-    jt = ju / sd[None, :]
-    info = temper * jt.T @ jt / sigma**2 + np.diag(1.0 / sd**2)
-    cov = np.linalg.inv(info)
+    jt = -jacobian(u)[:n] * sigma / np.sqrt(temper) / sd[None, :]
+    cov = np.linalg.inv(temper * jt.T @ jt / sigma**2 + np.diag(1.0 / sd**2))
     log.info("MAP of %s: %s, sigma = %.4g (%d simulations)", problem.structure.name,
              ", ".join(f"{nm}={v:.4g}" for nm, v in zip(problem.structure.free_parameters,
                                                         theta_phys)), sigma, count[0])
+    pred, _ = problem.predicted(np.append(theta_phys, sigma))
+    residual = problem.chain(problem.rel_acc) - pred[0]
     return PointFit(np.append(theta_phys, sigma), cov, residual, problem.parameter_names,
                     count[0])
 
@@ -194,11 +238,11 @@ def fit_map(problem: Problem, priors: Mapping[str, PriorSpec], temper: float = 1
 # --------------------------------------------------------------------------- sensitivities
 
 
-def sensitivities(problem: Problem, theta: np.ndarray, scale: np.ndarray) -> np.ndarray:
-    """d z''(t) / d theta_j over the whole record by central differences (one batched call).
+def sensitivities(problem: ChainProblem, theta: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """d z''(t) / d theta_j (through the chain) over the record by central differences.
 
     theta: (free physical parameters..., sigma); scale: a typical spread of each free
-    parameter (posterior sd); the step is 0.05 scale, kept above the parameter's lower bound.
+    parameter (posterior sd); the step is 0.05 scale. One batched simulation.
     Returns (samples, P) in m/s^2 per unit of each parameter.
     """
     theta = np.asarray(theta, dtype=float)
@@ -211,20 +255,21 @@ def sensitivities(problem: Problem, theta: np.ndarray, scale: np.ndarray) -> np.
         up[j] += h[j]
         down[j] -= h[j]
         rows += [up, down]
-    sim = problem.simulate(np.array(rows))
-    acc = np.where(sim.ok[:, None], sim.rel_acc, 0.0)
-    return np.column_stack([(acc[2 * j] - acc[2 * j + 1]) / (2 * h[j]) for j in range(p)])
+    pred, ok = problem.predicted(np.array(rows))
+    pred = np.where(ok[:, None], pred, 0.0)
+    return np.column_stack([(pred[2 * j] - pred[2 * j + 1]) / (2 * h[j]) for j in range(p)])
 
 
 @dataclass
 class BaselineState:
     """The baseline at its posterior mean: simulated state, residual and sensitivities.
 
-    All arrays over the whole record; ``theta`` = (free parameters..., sigma);
-    ``theta_sd`` the posterior sd of each; ``samples`` posterior draws (rows like theta).
+    All arrays over the problem's (possibly shortened) record; z'' and the residual through
+    the measurement chain; ``theta`` = (free parameters..., sigma); ``theta_sd`` the posterior
+    sd of each; ``samples`` posterior draws (rows like theta).
     """
 
-    problem: Problem
+    problem: ChainProblem
     theta: np.ndarray
     theta_sd: np.ndarray
     samples: np.ndarray
@@ -239,7 +284,7 @@ class BaselineState:
         return self.problem.parameter_names
 
 
-def baseline_state(problem: Problem, samples: np.ndarray) -> BaselineState:
+def baseline_state(problem: ChainProblem, samples: np.ndarray) -> BaselineState:
     """Posterior mean, its simulated response and residual, and the sensitivities there."""
     samples = np.atleast_2d(np.asarray(samples, dtype=float))
     theta = samples.mean(axis=0)
@@ -247,6 +292,7 @@ def baseline_state(problem: Problem, samples: np.ndarray) -> BaselineState:
     sim = problem.simulate(theta)
     if not sim.ok[0]:
         raise RuntimeError(f"the posterior mean of {problem.structure.name} cannot be simulated")
+    model = problem.chain(sim.rel_acc[0])
     jac = sensitivities(problem, theta, sd)
     return BaselineState(problem, theta, sd, samples, sim.rel_disp[0], sim.rel_vel[0],
-                         sim.rel_acc[0], problem.rel_acc - sim.rel_acc[0], jac)
+                         model, problem.chain(problem.rel_acc) - model, jac)

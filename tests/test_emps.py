@@ -1,0 +1,174 @@
+"""EMPS (harvester.emps) on slices of the real recordings: controller, closed loop, IDIM-LS."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import arviz as az
+import numpy as np
+import pandas as pd
+import pytest
+import xarray as xr
+import yaml
+
+from harvester import emps
+from harvester.errors import DataError
+from harvester.frf_priors import fit_linear_frf
+from harvester.identify import TMCMCSettings, identify
+from harvester.priors import PriorSpec
+from harvester.simulate import simulate
+
+ROOT = Path(__file__).parents[1]
+CFG = yaml.safe_load((ROOT / "config/config.yaml").read_text())["emps"]
+TRAINING, VALIDATION = Path(CFG["training"]), Path(CFG["validation"])
+pytestmark = pytest.mark.skipif(not TRAINING.is_file(), reason="EMPS data not available")
+#: Published parameters in our layout order for the model viscous + coulomb_friction.
+MODEL = emps.BASELINE_TERMS + ("coulomb_friction",)
+
+
+def published_theta(problem, sigma: float = 2e-6) -> np.ndarray:
+    ours = {our: emps.PUBLISHED[name] for name, our in emps.PARAMETERS.items()}
+    return np.array([[ours[n] for n in problem.structure.free_parameters] + [sigma]])
+
+
+def sliced(record: emps.EmpsRecord, stop_s: float) -> emps.EmpsRecord:
+    n = int(round(stop_s / record.dt))
+    return emps.EmpsRecord(record.name, record.time[:n], record.qm[:n], record.qg[:n],
+                           record.vir[:n], record.loop, record.pulses[:n])
+
+
+@pytest.fixture(scope="module")
+def training() -> emps.EmpsRecord:
+    return emps.load_emps(TRAINING, CFG["sha256"]["training"])
+
+
+@pytest.fixture(scope="module")
+def validation() -> emps.EmpsRecord:
+    return emps.load_emps(VALIDATION, CFG["sha256"]["validation"])
+
+
+def test_files_and_checksums(training, validation, tmp_path) -> None:
+    assert len(training) == len(validation) == 24841
+    assert training.dt == pytest.approx(1e-3, rel=1e-4)
+    assert training.loop == emps.ServoLoop(pytest.approx(35.1507, rel=1e-5), 160.18, 243.45)
+    assert not training.pulses.any() and set(np.unique(validation.pulses)) == {0.0, 5.0}
+    with pytest.raises(DataError, match="SHA256"):
+        emps.load_emps(TRAINING, "0" * 64)
+    with pytest.raises(DataError, match="file not found"):
+        emps.load_emps(tmp_path / "none.mat")
+
+
+def test_controller_law_matches_the_recorded_voltage(training, validation) -> None:
+    """vir = kv (kp (qg - qm) - (qm_k - qm_k-2) / 2 dt) + pulses: 0.3 % residual, gains 1."""
+    for rec in (training, validation):
+        check = emps.check_controller(rec)
+        assert check.rel_residual < 0.004
+        assert check.gains_scale == pytest.approx((1.0, 1.0), abs=1e-3)
+        assert check.rel_residual_one_step > 5 * check.rel_residual  # a one-step velocity is not it
+    assert emps.check_controller(validation).pulse_gain == pytest.approx(1.014, abs=0.003)
+    assert np.isnan(emps.check_controller(training).pulse_gain)
+
+
+def test_closed_loop_reproduces_qm_where_open_loop_drifts(training) -> None:
+    """Published parameters on 8 s: closed loop within 3 um RMS; open loop off by millimetres."""
+    rec = sliced(training, 8.0)
+    p = emps.closed_loop_problem(rec, MODEL)
+    q = p.predict(published_theta(p))[0]
+    rms_closed = np.sqrt(np.mean((q - rec.qm) ** 2))
+    assert rms_closed < 3e-6
+    lay = p.structure.layout
+    open_loop = simulate(lay, p.layout_params(published_theta(p)), rec.force, rec.dt,
+                         force_input=True).rel_disp[0] + rec.qm[0]
+    assert np.sqrt(np.mean((open_loop - rec.qm) ** 2)) > 100 * rms_closed
+
+
+def test_one_substep_is_converged(training) -> None:
+    rec = sliced(training, 5.0)
+    p = emps.closed_loop_problem(rec, MODEL)
+    args = (p.structure.layout, p.layout_params(published_theta(p)), rec.qg,
+            np.zeros(len(rec)), rec.loop, rec.dt, rec.qm[0])
+    one = emps.simulate_closed_loop(*args, n_substeps=1).rel_disp[0]
+    fine = emps.simulate_closed_loop(*args, n_substeps=16).rel_disp[0]
+    assert np.max(np.abs(one - fine)) < 1e-8  # m (3 nm found), against a ~1.7e-6 m residual
+
+
+def test_pulses_enter_the_validation_loop(validation) -> None:
+    rec = sliced(validation, 6.0)
+    with_pulses = emps.closed_loop_problem(rec, MODEL)
+    without = emps.closed_loop_problem(rec, MODEL, disturbance=np.zeros(len(rec)))
+    th = published_theta(with_pulses)
+    err = [np.sqrt(np.mean((p.predict(th)[0] - rec.qm) ** 2)) for p in (with_pulses, without)]
+    assert err[0] < 4e-6 < 10 * err[0] < err[1]
+
+
+def test_likelihood_prefers_coulomb_friction(training) -> None:
+    rec = sliced(training, 8.0)
+    p = emps.closed_loop_problem(rec, MODEL)
+    th = published_theta(p)
+    no_friction = th.copy()
+    no_friction[0, p.parameter_names.index("F_coulomb")] = 0.0
+    ll = p.loglike(np.vstack([th, no_friction]))
+    assert ll[0] > ll[1] + 100
+    assert p.n_data == len(range(0, len(rec), 10))
+
+
+def test_idim_ls_reproduces_the_published_values(training) -> None:
+    fit = emps.idim_ls(training)
+    for name, value in emps.PUBLISHED.items():
+        assert fit.values[name] == pytest.approx(value, rel=0.01), name
+
+
+def test_instrumented_frf_gives_the_mass(training) -> None:
+    fit = fit_linear_frf(emps.to_recording(training), emps.KNOWN, (0.5, 20.0), reference="qg")
+    assert fit.values["k"] == 0.0 and fit.fitted == ("M", "c_m")
+    assert fit.values["M"] == pytest.approx(emps.PUBLISHED["M"], rel=0.1)
+
+
+def test_model_names() -> None:
+    assert emps.emps_model_name(MODEL) == "viscous+coulomb_friction"
+    assert emps.model_terms("viscous") == emps.BASELINE_TERMS
+    assert emps.model_terms("viscous+coulomb_friction") == MODEL
+    with pytest.raises(KeyError):
+        emps.model_terms("viscous+nonsense")
+
+
+def fake_idata(values: dict[str, np.ndarray], log_evidence: list[float]) -> az.InferenceData:
+    post = xr.Dataset({k: (("chain", "draw"), v) for k, v in values.items()})
+    stats = xr.Dataset({"log_evidence": (("chain",), np.array(log_evidence))})
+    return az.InferenceData(posterior=post, sample_stats=stats)
+
+
+def test_parameter_and_evidence_tables() -> None:
+    rng = np.random.default_rng(0)
+    draws = {our: emps.PUBLISHED[name] + 0.01 * rng.standard_normal((2, 50))
+             for name, our in emps.PARAMETERS.items()}
+    idata = fake_idata(draws, [10.0, 10.2])
+    table = emps.parameters_table(idata)
+    assert list(table.columns) == ["parameter", "mean", "sd", "q2.5", "q97.5", "published"]
+    assert list(table["parameter"]) == ["M", "Fv", "Fc", "offset"]
+    comparison = emps.comparison_table(table, emps.PUBLISHED)
+    assert comparison["within_tolerance"].all() and (comparison["idim_ls_error_pct"] == 0).all()
+    runs = {"viscous": fake_idata({"M": draws["M"]}, [5.0, 5.0]),
+            "viscous+coulomb_friction": idata,
+            "viscous+quadratic_damping": fake_idata({"M": draws["M"]}, [7.0, 7.0])}
+    ev, named = emps.evidence_table(runs)
+    assert named == "coulomb_friction"
+    assert list(ev["model"]) == ["viscous+coulomb_friction", "viscous+quadratic_damping",
+                                 "viscous"]
+    assert ev.loc[ev["model"] == "viscous", "log_evidence_gain"].item() == 0.0
+
+
+@pytest.mark.slow
+def test_tmcmc_on_a_slice_is_within_5_percent(training) -> None:
+    """TMCMC, Coulomb model, first 12 s, 200 particles: every parameter within 5 % (~1 min)."""
+    rec = sliced(training, 12.0)
+    p = emps.closed_loop_problem(rec, MODEL)
+    priors = {"M": PriorSpec("M", 90.0, 25.0, "kg"), "c_m": PriorSpec("c_m", 200.0, 100.0, ""),
+              "F_coulomb": PriorSpec("F_coulomb", 10.0, 20.0, "N"),
+              "F_offset": PriorSpec("F_offset", 0.0, 10.0, "N", -np.inf),
+              "sigma": PriorSpec("sigma", 1e-5, 1e-5, "m")}
+    idata = identify(p, priors, TMCMCSettings(particles=200, chains=1, seed=1,
+                                              target_accept=0.25))
+    table = emps.comparison_table(emps.parameters_table(idata), {})
+    assert table["within_tolerance"].all(), table
+    assert isinstance(table, pd.DataFrame)

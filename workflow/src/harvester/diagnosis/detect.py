@@ -1,0 +1,369 @@
+"""Detect a mismatch between a recording and a baseline posterior, calibrated by simulation.
+
+The question: are the baseline's residuals explained by its noise model, i.e. are they
+stationary noise unrelated to the motion, as they would be if the structure were right?
+Colour alone is not evidence (the recordings are low-passed), so every statistic is computed
+in the frame of ``spectral.py`` (passband only, weighted by the inverse of the residual's
+smoothed spectrum, with the part the baseline's parameters can absorb projected out) and
+calibrated by ``bootstrap`` replicates of stationary Gaussian noise with the residual's
+spectrum passed through the same computations (a parametric bootstrap from the fitted
+baseline: the residual of a replicate is noise, since the signatures and sensitivities depend on
+the simulated motion only).
+
+Three families of statistics:
+
+``library``  score (Lagrange multiplier) tests: for each signature g of a candidate effect
+             (``signatures.py``), z = <g_perp, r> / sd, sd from the replicates; one-sided for
+             effects whose strength cannot be negative; an effect's statistic is the largest
+             z^2 over its shape grid, the family's the largest over effects.
+``windows``  the largest standardised log share of residual energy in one time window.
+``regions``  the largest standardised log share of residual energy in one region of the state.
+
+The family p-values are combined by their minimum, itself calibrated on the replicates, so the
+verdict's false-alarm rate is ``alpha`` whatever the number of statistics. Prior-to-posterior
+conflicts (the posterior mean far in the prior's tail while the data dominate) are reported
+beside it: a missing effect that the parameters absorb leaves white-looking residuals but drags
+the parameters away from what the initial modelling said.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from harvester.diagnosis.baseline import BaselineState
+from harvester.diagnosis.locate import (FrequencyBands, Standardised, StateRegions,
+                                        TimeWindows, standardise)
+from harvester.diagnosis.signatures import Signature, motion_scale, signatures
+from harvester.diagnosis.spectral import (PASSBAND_MARGIN, Frame, Metric, Projector,
+                                          extrapolated_input_psd, noise_replicates)
+from harvester.priors import PriorSpec
+from harvester.pymc_models import default_prior
+
+log = logging.getLogger("harvester.diagnosis")
+
+FAMILIES = ("library", "windows", "regions")
+
+
+@dataclass(frozen=True)
+class DetectionSettings:
+    """Calibration and location settings.
+
+    bootstrap: noise replicates; chain_components: replicates in which the baseline is
+    re-simulated through a surrogate measurement chain (input-sensor noise and the input's
+    content above the preprocessing cut-off; 0 for stationary noise only), cycled over the
+    replicates; base_noise_fraction: share of the residual's noise level attributed to the
+    base accelerometer (0.5: two equal sensors, as rel_acc = mass - base channel);
+    alpha: false-alarm rate of the verdict; window_s: length of
+    the time windows (s); conflict_alpha: family-wise level of the prior-posterior conflict
+    flags; conflict_data_dominated: a conflict needs posterior sd below this fraction of the
+    prior sd; seed: replicates' random seed.
+    """
+
+    bootstrap: int = 400
+    chain_components: int = 100
+    base_noise_fraction: float = 0.5
+    alpha: float = 0.05
+    window_s: float = 1.0
+    conflict_alpha: float = 0.01
+    conflict_data_dominated: float = 0.5
+    seed: int = 0
+
+
+@dataclass
+class Conflict:
+    """Where a posterior sits in its prior: z in prior sds and the prior's two-sided tail mass."""
+
+    parameter: str
+    prior_mean: float
+    prior_sd: float
+    posterior_mean: float
+    posterior_sd: float
+    z: float
+    tail_probability: float
+    conflict: bool
+
+    def to_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+@dataclass
+class CandidateScore:
+    """An effect's best score over its shape grid."""
+
+    effect: str
+    label: str  # signature label of the best shape
+    index: int  # index of that signature
+    z: float
+    statistic: float  # z^2 (one-sided where the strength is non-negative)
+    p_value: float  # calibrated on the replicates (max over the effect's grid)
+    strength: float  # weighted least-squares estimate of the strength at the best shape
+    strength_se: float
+    explained_share: float  # share of the (weighted) residual energy it explains
+
+
+@dataclass
+class Detection:
+    """Everything the ranking, the report and the figures need."""
+
+    frame: Frame
+    temper: float
+    alpha: float
+    p_value: float
+    family_p: dict[str, float]
+    family_statistic: dict[str, float]
+    signatures: list[Signature] = field(repr=False)
+    z: np.ndarray = field(repr=False)  # per signature
+    absorbed: np.ndarray = field(repr=False)  # (signatures, P): parameter shift per unit strength
+    gram: np.ndarray = field(repr=False)  # <g_perp, g_perp> per signature
+    candidates: list[CandidateScore] = field(repr=False)
+    conflicts: list[Conflict] = field(repr=False)
+    windows: TimeWindows = field(repr=False)
+    window_stats: Standardised = field(repr=False)
+    regions: StateRegions = field(repr=False)
+    region_stats: Standardised = field(repr=False)
+    bands: FrequencyBands = field(repr=False)
+    band_energy: np.ndarray = field(repr=False)  # residual energy per band
+    band_explained: np.ndarray = field(repr=False)  # energy explained by the signatures
+    band_explained_stats: Standardised = field(repr=False)
+    spectrum: np.ndarray = field(repr=False)  # smoothed periodogram of the residual
+    residual_dft: np.ndarray = field(repr=False)
+    residual_band: np.ndarray = field(repr=False)  # band-limited residual over the window
+    explained_band: np.ndarray = field(repr=False)  # its part explained by the signatures
+    sigma: float = 0.0  # RMS residual over the window (m/s^2)
+
+    @property
+    def significant(self) -> bool:
+        return self.p_value < self.alpha
+
+    @property
+    def conflict(self) -> bool:
+        return any(c.conflict for c in self.conflicts)
+
+
+def temper_from_spectrum(residual_dft: np.ndarray, spectrum: np.ndarray, frame: Frame,
+                         quantile: float = 0.9) -> float:
+    """lambda = effective fraction of independent samples for eq. (10) on this residual.
+
+    The variance of the residual over the window divided by the variance white noise would
+    have at the in-band level of the residual's spectrum (its ``quantile`` over the passband,
+    so that the densest part of the band sets it). Band-limited white noise to B Hz gives
+    about 2 B / fs (0.16 for 20 Hz at 256 Hz); a white residual gives 1.
+    """
+    total = 2.0 * np.sum(np.abs(residual_dft) ** 2)
+    band = frame.mask > 0.5
+    level = float(np.quantile(spectrum[band], quantile))
+    lam = total / (frame.n * level)
+    return float(np.clip(lam, 1.0 / frame.n, 1.0))
+
+
+def prior_conflicts(names: tuple[str, ...], samples: np.ndarray,
+                    priors: Mapping[str, PriorSpec], settings: DetectionSettings
+                    ) -> list[Conflict]:
+    """Prior-to-posterior check of every physical parameter (sigma excluded)."""
+    out = []
+    physical = [n for n in names if n != "sigma"]
+    level = settings.conflict_alpha / max(len(physical), 1)
+    for j, name in enumerate(names):
+        if name == "sigma":
+            continue
+        spec = priors.get(name) or default_prior(name)
+        x = samples[:, j]
+        mean = float(np.mean(x))
+        sd = float(np.std(x, ddof=1)) if len(x) > 1 else 0.0
+        if np.isfinite(spec.lower):
+            cdf = float(spec.distribution().cdf(mean))
+        else:
+            from scipy.stats import norm
+            cdf = float(norm.cdf(mean, spec.mean, spec.sd))
+        tail = float(min(1.0, 2.0 * min(cdf, 1.0 - cdf)))
+        z = (mean - spec.mean) / spec.sd
+        flagged = tail < level and sd < settings.conflict_data_dominated * spec.sd
+        out.append(Conflict(name, spec.mean, spec.sd, mean, sd, float(z), tail, bool(flagged)))
+    return out
+
+
+def chain_replicates(state: BaselineState, frame: Frame, spectrum: np.ndarray,
+                     settings: DetectionSettings, rng: np.random.Generator) -> np.ndarray:
+    """DFTs (bootstrap, bins) of residuals of recordings made by the fitted baseline.
+
+    Each of ``chain_components`` components re-simulates the baseline at its posterior mean
+    driven by what the true input may have been: the measured base acceleration minus a
+    draw of base-sensor noise, plus a draw of the content the preprocessing low-pass removed
+    (``extrapolated_input_psd``); its measured z'' carries the same sensor noise and goes
+    through the chain. That reproduces the state-dependent parts of a correct model's
+    residual: input noise seen through the nonlinear structure, and the in-band leakage of the
+    removed content through friction. Stationary output noise with the rest of the
+    residual's spectrum (at least 10 % of it) is added to each replicate.
+    """
+    problem = state.problem
+    count = settings.bootstrap
+    n_comp = min(settings.chain_components, count)
+    if n_comp <= 0:
+        return noise_replicates(spectrum, frame, count, rng)
+    fs = 1.0 / problem.dt
+    y = problem.base_acc
+    n_rec = len(y)
+    freqs = np.fft.rfftfreq(n_rec, problem.dt)
+    band = frame.mask > 0.5
+    # base-sensor noise: white at a share of the residual's in-band level, through the chain
+    level = float(np.median(spectrum[band])) / (frame.n * np.mean(frame.taper**2))
+    sd_base = np.sqrt(settings.base_noise_fraction * level)
+    removed = None
+    if problem.lowpass_hz is not None:
+        f_in, p_in = extrapolated_input_psd(y, fs, problem.lowpass_hz)
+        gain = 1.0 / (1.0 + (freqs / problem.lowpass_hz) ** (2 * problem.filter_order))
+        removed = np.interp(freqs, f_in, p_in) * (1.0 - gain**2)
+    theta = state.theta
+    comps = np.empty((n_comp, frame.freqs.size), dtype=complex)
+    for i in range(n_comp):
+        noise_b = problem.chain(sd_base * rng.standard_normal(n_rec))
+        truth_input = y - noise_b
+        if removed is not None:
+            white = np.fft.rfft(rng.standard_normal(n_rec))
+            truth_input = truth_input + np.fft.irfft(white * np.sqrt(removed * fs / 2.0),
+                                                     n=n_rec)
+        sim = problem.simulate(theta, base_acc=truth_input)
+        acc = sim.rel_acc[0] if sim.ok[0] else state.rel_acc
+        comp = problem.chain(acc) - state.rel_acc - noise_b
+        comps[i] = frame.dft(comp)
+    simulated = frame.smoothed_mean(np.mean(np.abs(comps) ** 2, axis=0))
+    rest = np.maximum(spectrum - simulated, 0.1 * spectrum)
+    out = noise_replicates(rest, frame, count, rng)
+    out += comps[np.arange(count) % n_comp]
+    return out
+
+
+def _rank_p(observed: float, replicates: np.ndarray) -> float:
+    return float((1.0 + np.sum(replicates >= observed)) / (1.0 + replicates.size))
+
+
+def _replicate_p(replicates: np.ndarray) -> np.ndarray:
+    """p-value of each replicate among all replicates (fraction at least as large)."""
+    order = np.sort(replicates)
+    return (replicates.size - np.searchsorted(order, replicates, side="left")) / replicates.size
+
+
+def detect(state: BaselineState, window: tuple[int, int], priors: Mapping[str, PriorSpec],
+           candidates: list[str], settings: DetectionSettings = DetectionSettings(),
+           time: np.ndarray | None = None) -> Detection:
+    """Calibrated detection and location of a mismatch of the baseline over ``window``.
+
+    The analysed band ends at PASSBAND_MARGIN x the measurement chain's cut-off (the
+    problem's ``lowpass_hz``; Nyquist when there is none).
+    """
+    problem = state.problem
+    fs = 1.0 / problem.dt
+    start, stop = window
+    if stop > len(state.residual):
+        raise ValueError(f"window {window} beyond the problem's record ({len(state.residual)})")
+    f_high = PASSBAND_MARGIN * (problem.lowpass_hz or 0.5 * fs)
+    frame = Frame(fs, start, stop, f_high)
+    time = np.arange(len(problem.rel_acc)) * problem.dt if time is None else time
+
+    raw = frame.dft(state.residual)
+    jac = frame.dft(state.jacobian.T)
+    first = Projector(Metric(frame.mask), jac).apply(raw)
+    spectrum = frame.smoothed_periodogram(first)
+    metric = Metric(frame.mask / spectrum)
+    proj = Projector(metric, jac)
+    resid = proj.apply(raw)
+    temper = temper_from_spectrum(raw, spectrum, frame)
+
+    scale = motion_scale(state, window, f_high)
+    sigs = signatures(state, scale, candidates)
+    G = frame.dft(np.array([s.values for s in sigs])) if sigs else np.zeros((0, raw.size))
+    Gp = proj.apply(G) if sigs else G
+    absorbed = proj.coefficients(G) if sigs and proj.solve else np.zeros((len(sigs), 0))
+    gram = np.einsum("ij,ij->i", Gp.real * metric.weight, Gp.real) + \
+        np.einsum("ij,ij->i", Gp.imag * metric.weight, Gp.imag)
+
+    rng = np.random.default_rng(settings.seed)
+    reps = proj.apply(chain_replicates(state, frame, spectrum, settings, rng))
+    log.info("detection over %.1f-%.1f s, band %.2f-%.1f Hz, %d signatures, %d replicates",
+             time[start], time[stop - 1], frame.f_low, f_high, len(sigs), settings.bootstrap)
+
+    # library: score tests
+    fam_obs: dict[str, float] = {}
+    fam_rep: dict[str, np.ndarray] = {}
+    cand_scores: list[CandidateScore] = []
+    z = np.zeros(len(sigs))
+    if sigs:
+        s_obs = metric.inner(resid, Gp)[0]
+        s_rep = metric.inner(reps, Gp)
+        sd = s_rep.std(axis=0, ddof=1)
+        sd = np.where(sd > 0, sd, np.inf)
+        z = s_obs / sd
+        z_rep = s_rep / sd
+        signed = np.array([s.signed for s in sigs])
+        stat = np.where(signed, z**2, np.maximum(z, 0) ** 2)
+        stat_rep = np.where(signed, z_rep**2, np.maximum(z_rep, 0) ** 2)
+        total_w = float(metric.inner(resid, resid)[0, 0])
+        effects = list(dict.fromkeys(s.effect for s in sigs))
+        eff_obs, eff_rep = [], []
+        for e in effects:
+            idx = np.array([i for i, s in enumerate(sigs) if s.effect == e])
+            best = int(idx[np.argmax(stat[idx])])
+            eff_obs.append(stat[best])
+            eff_rep.append(np.max(stat_rep[:, idx], axis=1))
+            g2 = max(gram[best], 1e-300)
+            cand_scores.append(CandidateScore(
+                effect=e, label=sigs[best].label, index=best, z=float(z[best]),
+                statistic=float(stat[best]), p_value=_rank_p(stat[best], eff_rep[-1]),
+                strength=float(s_obs[best] / g2), strength_se=float(sd[best] / g2),
+                explained_share=float(s_obs[best] ** 2 / g2 / total_w)))
+        fam_obs["library"] = float(np.max(eff_obs))
+        fam_rep["library"] = np.max(np.array(eff_rep), axis=0)
+
+    # windows and regions: shares of band-limited residual energy
+    series = frame.band_limited(resid)
+    series_rep = frame.band_limited(reps)
+    windows = TimeWindows(frame, time, settings.window_s)
+    w_stats = standardise(windows.statistic(series), windows.statistic(series_rep))
+    regions = StateRegions(frame, state.rel_disp, state.rel_vel, state.rel_acc,
+                           problem.base_acc)
+    r_stats = standardise(regions.statistic(series), regions.statistic(series_rep))
+    fam_obs["windows"], fam_rep["windows"] = w_stats.family_max, w_stats.family_max_replicates
+    fam_obs["regions"], fam_rep["regions"] = r_stats.family_max, r_stats.family_max_replicates
+
+    family_p = {f: _rank_p(fam_obs[f], fam_rep[f]) for f in fam_obs}
+    minp_obs = min(family_p.values())
+    minp_rep = np.min(np.array([_replicate_p(fam_rep[f]) for f in fam_obs]), axis=0)
+    p_value = float((1.0 + np.sum(minp_rep <= minp_obs)) / (1.0 + minp_rep.size))
+
+    # frequency bands: residual energy and the part the signatures explain
+    bands = FrequencyBands(frame)
+    band_energy = bands.band_energy(resid)
+    if sigs:
+        gg = metric.gram(Gp)
+        scl = np.sqrt(np.maximum(np.diag(gg), 1e-300))
+        pinv = np.linalg.pinv(gg / np.outer(scl, scl), rcond=1e-6) / np.outer(scl, scl)
+        explained = (pinv @ metric.inner(Gp, resid))[:, 0] @ Gp
+        explained_rep = (metric.inner(reps, Gp) @ pinv.T) @ Gp
+    else:
+        explained = np.zeros_like(resid)
+        explained_rep = np.zeros_like(reps)
+    tot = band_energy.sum()
+    band_expl = bands.band_energy(explained)
+    band_expl_rep = bands.band_energy(explained_rep) / bands.band_energy(reps).sum(
+        axis=1, keepdims=True)
+    b_stats = standardise(band_expl / tot, band_expl_rep)
+
+    names = problem.parameter_names
+    conflicts = prior_conflicts(names, state.samples, priors, settings)
+    sigma = float(np.sqrt(np.mean(state.residual[start:stop] ** 2)))
+    det = Detection(
+        frame=frame, temper=temper, alpha=settings.alpha, p_value=p_value, family_p=family_p,
+        family_statistic=fam_obs, signatures=sigs, z=z, absorbed=absorbed, gram=gram,
+        candidates=cand_scores, conflicts=conflicts, windows=windows, window_stats=w_stats,
+        regions=regions, region_stats=r_stats, bands=bands, band_energy=band_energy,
+        band_explained=band_expl, band_explained_stats=b_stats, spectrum=spectrum,
+        residual_dft=resid, residual_band=series, explained_band=frame.band_limited(explained),
+        sigma=sigma)
+    log.info("detection: p = %.3g (%s); conflicts: %s", p_value,
+             ", ".join(f"{f} p={p:.3g}" for f, p in family_p.items()),
+             ", ".join(c.parameter for c in conflicts if c.conflict) or "none")
+    return det

@@ -1,0 +1,221 @@
+"""The frequency-domain frame of the diagnosis: analysis window, passband, noise spectrum,
+weighted projections and noise replicates for calibration.
+
+Residuals of a correct model are not white: the recordings are zero-phase low-passed (20 Hz
+at 256 Hz in the study) and sensors add coloured noise. Every statistic of the diagnosis is
+therefore computed from the residual's DFT restricted to the passband of the measurement
+chain, weighted by the inverse of the residual's own smoothed spectrum (a generalised least
+squares metric), and calibrated by replicates of stationary Gaussian noise with that spectrum
+passed through exactly the same computations.
+
+Conventions: x is a record (..., n_record); the analysis window is samples [start, stop);
+``dft(x)`` is rfft(taper * x[start:stop]); inner products are
+<A, B> = sum_k W_k Re(conj(A_k) B_k) with W_k = mask_k / S_k (S_k the smoothed periodogram).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import ndimage, signal
+
+#: Lowest analysed frequency (Hz): below it z'' holds almost no energy (z'' ~ w^2 z).
+F_LOW_HZ = 0.1
+#: Width (Hz) of the running median that smooths the periodogram into the noise spectrum.
+SMOOTHING_HZ = 1.0
+#: Local slope (dB per octave) beyond which a roll-off is taken for an anti-alias or
+#: preprocessing low-pass rather than mechanics.
+STEEP_DB_PER_OCTAVE = 40.0
+#: Fraction of the detected passband edge kept (steep filters roll off just below it).
+PASSBAND_MARGIN = 0.9
+#: Fraction of the window tapered (Tukey) to avoid leakage from the window's edges.
+TAPER_FRACTION = 0.1
+
+
+def filter_cutoff(x: np.ndarray, fs: float) -> float | None:
+    """Cut-off (Hz) of a steep low-pass the record went through, from its spectrum alone.
+
+    A zero-phase Butterworth of order 8 cuts 96 dB per octave, far steeper than any
+    mechanical response or excitation spectrum (a resonance flank does not fall 40 dB in an
+    octave). The cut-off is the lowest frequency above 2 Hz where the log-PSD falls faster
+    than ``STEEP_DB_PER_OCTAVE`` locally and, from there, by more than that over the next
+    octave (or to 0.95 x Nyquist). Found a little below the -6 dB point, so the diagnosis's
+    own low-pass at that frequency keeps nothing the record's filter removed. None for a
+    record with no such roll-off.
+    """
+    x = np.asarray(x, dtype=float)
+    nyq = 0.5 * fs
+    nper = int(min(len(x) // 4, round(8.0 * fs)))
+    f, p = signal.welch(x - np.mean(x), fs=fs, nperseg=nper)
+    keep = f > 0
+    f, level = f[keep], 10.0 * np.log10(np.maximum(p[keep], 1e-300))
+    grid = 2.0 ** np.arange(np.log2(max(f[0], 0.5)), np.log2(0.95 * nyq), 1.0 / 32.0)
+    # average the log-PSD over 1/8 octave around each grid point
+    smooth = np.array([np.mean(level[(f >= g * 2**-0.0625) & (f <= g * 2**0.0625)])
+                       if np.any((f >= g * 2**-0.0625) & (f <= g * 2**0.0625))
+                       else np.interp(g, f, level) for g in grid])
+    step = 4  # 1/8 octave either side
+    for i in range(step, len(grid) - step):
+        if grid[i] < 2.0:
+            continue
+        slope = (smooth[i + step] - smooth[i - step]) / 0.25  # dB per octave
+        if slope > -STEEP_DB_PER_OCTAVE:
+            continue
+        j = min(i + 32, len(grid) - 1)
+        octaves = (j - i) / 32.0
+        if octaves >= 0.25 and smooth[i] - smooth[j] >= STEEP_DB_PER_OCTAVE * octaves:
+            return float(grid[i])
+    return None
+
+
+@dataclass
+class Frame:
+    """Analysis window, taper, frequency grid and passband mask."""
+
+    fs: float
+    start: int
+    stop: int
+    f_high: float
+    f_low: float = F_LOW_HZ
+    taper: np.ndarray = field(init=False, repr=False)
+    freqs: np.ndarray = field(init=False, repr=False)
+    mask: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        n = self.n
+        self.taper = signal.windows.tukey(n, TAPER_FRACTION)
+        self.freqs = np.fft.rfftfreq(n, 1.0 / self.fs)
+        f = self.freqs
+        mask = ((f >= self.f_low) & (f <= self.f_high)).astype(float)
+        # cosine roll-off over the top 10 % of the band, so band-limited series do not ring
+        top = 0.9 * self.f_high
+        roll = (f > top) & (f <= self.f_high)
+        mask[roll] = 0.5 * (1 + np.cos(np.pi * (f[roll] - top) / (self.f_high - top)))
+        self.mask = mask
+
+    @property
+    def n(self) -> int:
+        return self.stop - self.start
+
+    @property
+    def time_weight(self) -> np.ndarray:
+        """Squared taper: the weight of each sample in band-limited energies."""
+        return self.taper**2
+
+    def dft(self, x: np.ndarray) -> np.ndarray:
+        """rfft of the tapered window of x (..., n_record) -> (..., n_bins)."""
+        x = np.asarray(x, dtype=float)
+        return np.fft.rfft(self.taper * x[..., self.start:self.stop], axis=-1)
+
+    def band_limited(self, X: np.ndarray) -> np.ndarray:
+        """Time series (..., n) of a DFT restricted to the passband."""
+        return np.fft.irfft(X * self.mask, n=self.n, axis=-1)
+
+    def smoothed_periodogram(self, X: np.ndarray) -> np.ndarray:
+        """Running median of |X_k|^2 over SMOOTHING_HZ, divided by ln 2 (median -> mean).
+
+        The median ignores narrow lines and intermittent bursts, so the estimate is the level
+        of the broadband (noise) floor; zero-mean noise periodogram ordinates are exponential,
+        whose median is ln 2 x mean.
+        """
+        p = np.abs(X) ** 2
+        size = (1,) * (p.ndim - 1) + (self.smoothing_bins,)
+        s = ndimage.median_filter(p, size=size, mode="nearest") / np.log(2.0)
+        floor = 1e-12 * max(float(np.max(s)), 1e-300)
+        return np.maximum(s, floor)
+
+    @property
+    def smoothing_bins(self) -> int:
+        return max(5, int(round(SMOOTHING_HZ * self.n / self.fs)) | 1)
+
+    def smoothed_mean(self, p: np.ndarray) -> np.ndarray:
+        """Running mean of a spectrum over SMOOTHING_HZ."""
+        return ndimage.uniform_filter1d(p, self.smoothing_bins, mode="nearest")
+
+
+@dataclass
+class Metric:
+    """The weighted inner product <A, B> = sum_k W_k Re(conj(A_k) B_k), W = mask / S."""
+
+    weight: np.ndarray  # (bins,)
+
+    def inner(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """<A_i, B_j> for A (..., bins) and B (..., bins): matrix over the leading dims."""
+        A, B = np.atleast_2d(A), np.atleast_2d(B)
+        return (A.real * self.weight) @ B.real.T + (A.imag * self.weight) @ B.imag.T
+
+    def gram(self, A: np.ndarray) -> np.ndarray:
+        return self.inner(A, A)
+
+
+class Projector:
+    """Removes from DFTs the part the baseline's own parameters can absorb.
+
+    ``basis`` (P, bins) holds the DFTs of the baseline's sensitivities d z''/d theta_j;
+    ``apply(X)`` returns X - basis^T beta with beta the weighted least-squares coefficients.
+    """
+
+    def __init__(self, metric: Metric, basis: np.ndarray) -> None:
+        self.metric = metric
+        self.basis = np.atleast_2d(basis)
+        if self.basis.size == 0 or self.basis.shape[0] == 0:
+            self.solve = None
+            return
+        g = metric.gram(self.basis)
+        scale = np.sqrt(np.maximum(np.diag(g), 1e-300))
+        gs = g / np.outer(scale, scale)
+        self._pinv = np.linalg.pinv(gs, rcond=1e-10) / np.outer(scale, scale)
+        self.solve = True
+
+    def coefficients(self, X: np.ndarray) -> np.ndarray:
+        X = np.atleast_2d(X)
+        return self.metric.inner(X, self.basis) @ self._pinv.T
+
+    def apply(self, X: np.ndarray) -> np.ndarray:
+        X2 = np.atleast_2d(X)
+        if self.solve is None:
+            return X2.copy() if X.ndim > 1 else X.copy()
+        out = X2 - self.coefficients(X2) @ self.basis
+        return out if X.ndim > 1 else out[0]
+
+
+def noise_replicates(spectrum: np.ndarray, frame: Frame, count: int,
+                     rng: np.random.Generator) -> np.ndarray:
+    """DFTs (count, bins) of stationary Gaussian noise with the given periodogram level.
+
+    ``spectrum`` is the expected |dft(x)|^2 of the tapered window (as
+    :meth:`Frame.smoothed_periodogram` estimates it). Each replicate is generated as a whole
+    series, then tapered and transformed like the data, so edge effects and bin correlations
+    match.
+    """
+    n = frame.n
+    level = spectrum / np.mean(frame.taper**2)
+    white = np.fft.rfft(rng.standard_normal((count, n)), axis=-1)
+    series = np.fft.irfft(white * np.sqrt(level / n), n=n, axis=-1)
+    return np.fft.rfft(frame.taper * series, axis=-1)
+
+
+def extrapolated_input_psd(base_acc: np.ndarray, fs: float, cutoff_hz: float
+                           ) -> tuple[np.ndarray, np.ndarray]:
+    """(frequencies, PSD) of the base acceleration continued above a low-pass cut-off.
+
+    The preprocessing filter removed the input's content above the cut-off, and the response
+    of a nonlinear structure to it leaks into the band (the filter does not commute with
+    friction). The lost content is guessed by continuing the measured PSD's power law fitted
+    over 0.4-0.75 x the cut-off (slope clipped to [-60, 0] dB/decade: at least as much content
+    as a steep excitation filter would leave), which errs towards too much.
+    """
+    nper = int(min(len(base_acc) // 4, round(4.0 * fs)))
+    f, p = signal.welch(base_acc - np.mean(base_acc), fs=fs, nperseg=nper)
+    fit = (f >= 0.4 * cutoff_hz) & (f <= 0.75 * cutoff_hz) & (p > 0)
+    if fit.sum() < 3:
+        return f, p
+    slope, icpt = np.polyfit(np.log10(f[fit]), np.log10(p[fit]), 1)
+    slope = float(np.clip(slope, -6.0, 0.0))
+    pivot = 0.75 * cutoff_hz
+    level = 10.0 ** (icpt + slope * np.log10(pivot)) if slope == slope else p[fit][-1]
+    above = f > pivot
+    out = p.copy()
+    out[above] = level * (f[above] / pivot) ** slope
+    return f, out
