@@ -12,6 +12,8 @@ rule tmcmc:
         tmcmc=config["tmcmc"],
         lead_in=config["preprocess"]["training_lead_in"],
         samples=config["preprocess"]["training_samples"],
+        lowpass_hz=config["preprocess"]["lowpass_hz"],
+        filter_order=config["preprocess"]["filter_order"],
     threads: 2
     resources:
         mem_mb=4000,

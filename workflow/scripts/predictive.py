@@ -12,7 +12,9 @@ with rule_log(snakemake) as log:  # noqa: F821
     sm = snakemake  # noqa: F821
     rec = read_recording(sm.input.data)
     idata = az.from_netcdf(sm.input.posterior)
-    problem = make_problem(rec, idata.posterior.attrs["model"], read_json(sm.input.priors)["known"])
+    filt = idata.posterior.attrs.get("output_filter")
+    problem = make_problem(rec, idata.posterior.attrs["model"], read_json(sm.input.priors)["known"],
+                           output_filter=None if filt is None else (float(filt[0]), int(filt[1])))
     theta = thin(posterior_theta(idata), sm.params.predictive["samples"], sm.params.predictive["seed"])
     start = sm.params.lead_in
     stop = len(rec) if sm.params.samples is None else start + sm.params.samples

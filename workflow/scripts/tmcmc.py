@@ -12,7 +12,8 @@ with rule_log(snakemake) as log:  # noqa: F821
     priors = {n: PriorSpec(**p) for n, p in prior_file["priors"].items()}
     start = sm.params.lead_in
     problem = make_problem(read_recording(sm.input.data), sm.wildcards.model, prior_file["known"],
-                           window=(start, start + sm.params.samples))
+                           window=(start, start + sm.params.samples),
+                           output_filter=(sm.params.lowpass_hz, sm.params.filter_order))
     idata = identify(problem, priors, TMCMCSettings.from_config(sm.params.tmcmc))
     with atomic_path(sm.output[0]) as tmp:
         idata.to_netcdf(str(tmp))

@@ -107,22 +107,38 @@ def posterior_figure(samples: Mapping[str, np.ndarray], published: Mapping[str, 
 
 def tracking_figure(bands: Mapping[str, dict], path: str | Path, title: str,
                     window: tuple[float, float] | None = None, k: float = 3.0) -> None:
-    """Per model: measured tracking error (grey), model mean (black), +-k sd (param + sigma)."""
-    fig, axes = plt.subplots(len(bands), 1, figsize=(11, 2.8 * len(bands)), sharex=True,
-                             squeeze=False)
-    for ax, (label, b) in zip(axes[:, 0], bands.items()):
-        t = b["time"]
-        sel = slice(None) if window is None else (t >= window[0]) & (t <= window[1])
-        mean, sd = 1e6 * b["mean"][sel], 1e6 * b["sd"][sel]
-        ax.fill_between(t[sel], mean - k * sd, mean + k * sd, color="tab:blue", alpha=0.2, lw=0,
-                        label=f"mean $\\pm${k:g} sd (parameters + $\\sigma$)")
-        ax.plot(t[sel], 1e6 * b["measured"][sel], color="0.6", lw=0.7, label="measured")
-        ax.plot(t[sel], mean, color="k", lw=0.7, label="model mean (closed loop)")
-        ax.set_ylabel("$q - q_g$ ($\\mu$m)")
-        ax.set_title(f"{label}: RMS error {b['rms_position_um']:.2f} $\\mu$m", fontsize=9)
+    """Top: measured tracking error (grey) and the last model's mean (black). Below, per model:
+    the prediction error qm - q_mean with +-k sd (parameters and sigma) shaded, common scale."""
+    fig, axes = plt.subplots(len(bands) + 1, 1, figsize=(11, 2.5 * (len(bands) + 1)),
+                             sharex=True, squeeze=False)
+    axes = axes[:, 0]
+    last = list(bands)[-1]
+    t = bands[last]["time"]
+    sel = slice(None) if window is None else (t >= window[0]) & (t <= window[1])
+    axes[0].plot(t[sel], 1e6 * bands[last]["measured"][sel], color="0.6", lw=2.0,
+                 label="measured $q_m - q_g$")
+    axes[0].plot(t[sel], 1e6 * bands[last]["mean"][sel], color="k", lw=0.7,
+                 label=f"{last}, mean (closed loop)")
+    axes[0].set_ylabel("tracking error ($\\mu$m)")
+    axes[0].legend(fontsize=8, frameon=False, loc="upper left")
+    lim = 0.0
+    for ax, (label, b) in zip(axes[1:], bands.items()):
+        err = 1e6 * (b["measured"] - b["mean"])[sel]
+        sd = 1e6 * b["sd"][sel]
+        ax.fill_between(t[sel], -k * sd, k * sd, color="tab:blue", alpha=0.2, lw=0,
+                        label=f"$\\pm${k:g} sd (parameters + $\\sigma$)")
+        ax.plot(t[sel], err, color="0.4", lw=0.6, label="measured - model mean")
+        ax.axhline(0.0, color="k", lw=0.5)
+        ax.set_ylabel("$q_m - q$ ($\\mu$m)")
+        ax.set_title(f"{label}: RMS error {b['rms_position_um']:.2f} $\\mu$m over the record",
+                     fontsize=9)
+        lim = max(lim, float(np.max(np.abs(err))), float(k * np.max(sd)))
+    for ax in axes[1:]:
+        ax.set_ylim(-1.05 * lim, 1.05 * lim)
+    axes[1].legend(fontsize=8, frameon=False, ncol=2, loc="upper right")
+    for ax in axes:
         ax.margins(x=0)
-    axes[0, 0].legend(fontsize=8, frameon=False, ncol=3, loc="upper right")
-    axes[-1, 0].set_xlabel("time (s)")
+    axes[-1].set_xlabel("time (s)")
     fig.suptitle(f"{title}\n{REAL_NOTE}", fontsize=10)
     _save(fig, path)
 

@@ -68,7 +68,8 @@ def check_identifiable(free_base: tuple[str, ...], input_kind: str) -> None:
 
 
 def make_problem(recording: pd.DataFrame, model: str | ModelStructure, known: Mapping[str, float],
-                 window: tuple[int, int] | None = None, stride: int = 1) -> Problem:
+                 window: tuple[int, int] | None = None, stride: int = 1,
+                 output_filter: tuple[float, int] | None = None) -> Problem:
     """The identification problem for a recording (columns time, an input, an output).
 
     The recording's columns declare the kinds (``harvester.recording``): input ``base_acc``
@@ -76,6 +77,8 @@ def make_problem(recording: pd.DataFrame, model: str | ModelStructure, known: Ma
     from ``known`` are identified (:func:`free_base_parameters`); their priors come from
     ``harvester.frf_priors.initial_priors``. For a force input a missing m is set to 0
     (it does not enter eq. 1). ``stride``: the likelihood uses every stride-th sample.
+    ``output_filter`` (cut-off Hz, order): the zero-phase low-pass the recording went through,
+    applied to the simulated output too.
     """
     s = structure(model) if isinstance(model, str) else model
     kinds, u, y, dt = input_output(recording)
@@ -87,7 +90,7 @@ def make_problem(recording: pd.DataFrame, model: str | ModelStructure, known: Ma
     if "m" not in free and "m" not in known:
         known["m"] = 0.0
     return Problem(s, u, y, dt, known, window, input_kind=kinds.input_kind,
-                   output_kind=kinds.output_kind, stride=stride)
+                   output_kind=kinds.output_kind, stride=stride, output_filter=output_filter)
 
 
 def identify(problem: Problem, priors: Mapping[str, PriorSpec],
@@ -104,6 +107,8 @@ def identify(problem: Problem, priors: Mapping[str, PriorSpec],
     idata.posterior.attrs["model"] = problem.structure.name
     idata.posterior.attrs["terms"] = ",".join(problem.structure.terms)
     idata.posterior.attrs["known"] = ",".join(f"{k}={v!r}" for k, v in problem.known.items())
+    if problem.output_filter is not None:
+        idata.posterior.attrs["output_filter"] = list(problem.output_filter)
     idata.posterior.attrs["free_base"] = ",".join(problem.structure.free_base)
     idata.posterior.attrs["input_kind"] = problem.input_kind
     idata.posterior.attrs["output_kind"] = problem.output_kind

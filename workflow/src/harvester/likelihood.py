@@ -19,8 +19,10 @@ import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.signal import sosfiltfilt
 
 from harvester.recording import INPUT_KINDS, OUTPUT_KINDS
+from harvester.signals import butterworth_sos
 from harvester.simulate import Simulation, simulate
 from harvester.structures import ModelStructure
 
@@ -41,6 +43,7 @@ class Problem:
     dt: float  # s
     known: dict[str, float]  # values of the layout parameters that are not identified
     window: tuple[int, int] | None = None  # samples [start, stop) used by the likelihood
+    output_filter: tuple[float, int] | None = None  # (cut-off Hz, order) applied to simulated z''
     input_kind: str = "base_acc"
     output_kind: str = "rel_acc"
     stride: int = 1  # the likelihood uses every stride-th sample of the window
@@ -133,6 +136,10 @@ class Problem:
         """The simulated output of this problem's kind (particles, samples), NaN where failed."""
         out = (sim.rel_acc if self.output_kind == "rel_acc" else sim.rel_disp).copy()
         out[~sim.ok] = np.nan
+        if self.output_filter is not None and sim.ok.any():
+            cutoff, order = self.output_filter
+            sos = butterworth_sos(1.0 / self.dt, cutoff, order)
+            out[sim.ok] = sosfiltfilt(sos, out[sim.ok], axis=-1)
         return out
 
     def predict(self, theta: np.ndarray, input: np.ndarray | None = None) -> np.ndarray:

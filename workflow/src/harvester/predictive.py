@@ -64,12 +64,14 @@ def thin(theta: np.ndarray, n: int, seed: int) -> np.ndarray:
 
 def posterior_predictive(problem: Problem, theta: np.ndarray, base_acc: np.ndarray,
                          time: np.ndarray) -> PredictiveBand:
-    """Simulate every row of ``theta`` (free parameters..., sigma) for the base input."""
-    sim = problem.simulate(theta, base_acc=base_acc)
+    """Simulate every row of ``theta`` (free parameters..., sigma) for the input ``base_acc``
+    (the problem's input kind), giving the problem's output kind, filtered as its data were."""
+    sim = problem.simulate(theta, base_acc)
     keep = sim.ok
     if not keep.any():
         raise RuntimeError("no posterior sample could be simulated for this input")
-    return PredictiveBand(np.asarray(time), sim.rel_acc[keep], np.asarray(theta)[keep, -1])
+    out = problem.output_of(sim)
+    return PredictiveBand(np.asarray(time), out[keep], np.asarray(theta)[keep, -1])
 
 
 def nrmse(measured: np.ndarray, predicted: np.ndarray) -> float:

@@ -27,26 +27,31 @@ effect (library name)     generating form (library's form in brackets)
 coulomb_friction          linear device + Coulomb friction with stiction (Karnopp): F sgn(w)
                           while sliding; while |w| < 0.5 mm/s it holds the applied force up to
                           the breakaway F [F sgn(w), sgn regularised as tanh(w / 1 mm/s)]
-stribeck_friction         F exp(-|w| / v_s) sgn_e(w), exponent 1, e = 0.2 mm/s
-                          [exponent 2: F exp(-(w/v_s)^2) sgn(w)]
+stribeck_friction         F exp(-|w| / v_s) sgn_e(w), exponent 1, e = 0.2 mm/s, v_s drawn in
+                          [1, 8] mm/s [exponent 2: F exp(-(w/v_s)^2) sgn(w)]
 asymmetric_friction       friction stronger in one direction: the tanh law times (1 +- a),
-                          i.e. f = A |tanh(beta w)|, beta the baseline's [A sgn(w)^2]
+                          i.e. f = A |tanh(beta w)|, beta the baseline's, sign of A drawn
+                          [A sgn(w)^2]
 quadratic_damping         c |w|^1.8 sgn(w)  [c w |w|]
 cubic_stiffness           progressive (hardening) spring k |z|^2.5 sgn(z) [k z^3]; softening
                           at a visible strength turns the total stiffness negative within the
                           motion, so only hardening is generated
-end_stop                  Hertzian stop k (|z| - g)_+^1.5 sgn(z)  [linear k (|z| - g)_+]
-backlash                  gap g in the screw-nut coupling, Hertzian contact
-                          k_c delta^1.5 + Kelvin-Voigt damping c_c delta' (compressive only)
-                          [linear contact with Hunt-Crossley damping]
+end_stop                  Hertzian stop k (|z| - g)_+^1.5 sgn(z), g at a quantile of |z| drawn
+                          in [0.7, 0.9]  [linear k (|z| - g)_+]
+backlash                  gap g (the strength) between the mass and the screw side (J = M - m),
+                          Hertzian contact with Tsuji damping k_c delta^1.5 +
+                          c_c delta^0.25 delta' (compressive only), k_c = 1e11 N/m^1.5,
+                          c_c = 1e5 N s/m^1.25 [linear contact with Hunt-Crossley damping]
 hysteresis                Bouc-Wen pre-sliding force, n = 2:
-                          h' = A w - beta |w| |h| h - gamma w h^2, beta = gamma = A / (2 F^2)
+                          h' = A w - beta |w| |h| h - gamma w h^2, beta = gamma = A / (2 F^2),
+                          A = F / delta, pre-sliding displacement delta drawn in [0.1, 0.5] mm
                           [Dahl, n = 1]
 unmodelled_mode           a secondary rotor on a flexible coupling to the screw: driven by the
-                          relative motion z (m_2 u'' = k_2 (z - u) + c_2 (z' - u'))
+                          relative motion z (m_2 u'' = k_2 (z - u) + c_2 (z' - u')), strength
+                          m_2, f_mode drawn in [3, 18] Hz, zeta in [0.02, 0.1]
                           [a mode attached to the mass, driven by its absolute acceleration]
 inertia_error             extra mass dm on the oscillating mass: m and M both change, so the
-                          drive -m y'' changes too [M only]
+                          drive -m y'' changes too; sign drawn [M only]
 ========================= ====================================================================
 
 Effect-free scenarios (``none_tanh``, ``none_linear``; r = 0) carry no effect: they measure the
@@ -200,7 +205,8 @@ def _rhs(s, yb, dev, code, amp, shape, ds):
         ds[1] = acc
         return acc
     # backlash: mass m (z, z') and screw side J = M - m (r, r' = s[2], s[3]) in contact across
-    # a gap amp: delta = |z - r| - gap; Hertzian force k_c delta^1.5 + c_c delta', compressive
+    # a gap amp: delta = |z - r| - gap; Tsuji contact force k_c delta^1.5 + c_c delta^0.25
+    # delta' (continuous at touch-down), compressive only
     jq = M - m
     d = z - s[2]
     dd = v - s[3]
@@ -208,7 +214,7 @@ def _rhs(s, yb, dev, code, amp, shape, ds):
     pen = abs(d) - amp
     fb = 0.0
     if pen > 0.0:
-        fb = sg * max(shape[0] * pen ** 1.5 + shape[1] * sg * dd, 0.0)
+        fb = sg * max(shape[0] * pen ** 1.5 + shape[1] * pen ** 0.25 * sg * dd, 0.0)
     acc = (-m * yb - f_mass - fb) / m
     ds[1] = acc
     ds[2] = s[3]
@@ -289,9 +295,9 @@ def device_acceleration(y_dd: np.ndarray, fs: float, device: Device, code: int =
 class Family:
     """How one library effect is generated: law, strength parameter, shape draw, baseline.
 
-    ``shapes(rng, motion)`` draws the fixed shape parameters of one seed from the baseline's
-    motion (dict with z, v: displacement and velocity of the baseline on the output grid) and
-    returns (names, values). ``signed``: the strength's sign is drawn per seed (+ or -).
+    ``shapes(rng, motion)`` draws the fixed shape parameters of one seed (dict name -> value)
+    given the baseline (``motion``: its displacement ``z`` on the output grid and its friction
+    slope ``beta``). ``signed``: the strength's sign is drawn per seed (+ or -).
     ``guess``: a strength of the right order to start the calibration.
     """
 
@@ -304,7 +310,7 @@ class Family:
     guess: float
     baseline: str = "tanh"
     signed: bool = False
-    shapes: Callable[[np.random.Generator, Mapping[str, np.ndarray]],
+    shapes: Callable[[np.random.Generator, Mapping[str, Any]],
                      dict[str, float]] = field(default=lambda rng, motion: {}, repr=False)
     shape_order: tuple[str, ...] = ()
 
@@ -317,7 +323,7 @@ def _loguniform(rng: np.random.Generator, lo: float, hi: float) -> float:
 
 
 def _stop_gap(rng, motion):
-    q = rng.uniform(0.75, 0.95)
+    q = rng.uniform(0.7, 0.9)
     z = motion["z"]
     return {"gap_quantile": q, "gap": float(np.quantile(np.abs(z - np.median(z)), q))}
 
@@ -336,7 +342,7 @@ FAMILIES: dict[str, Family] = {f.effect: f for f in (
     Family("asymmetric_friction", ASYMMETRIC, "A", "N",
            "A |tanh(beta w)| (friction amplitude F_c + A up, F_c - A down; beta the baseline's)",
            "F_asym sgn(w)^2", guess=0.2, signed=True,
-           shapes=lambda rng, motion: {"beta_asym": 88.35}, shape_order=("beta_asym",)),
+           shapes=lambda rng, motion: {"beta_asym": motion["beta"]}, shape_order=("beta_asym",)),
     Family("quadratic_damping", POWER_DAMPING, "c_power", "N (s/m)^1.8",
            "c |w|^1.8 sgn(w)", "c_quad w |w|", guess=500.0,
            shapes=lambda rng, motion: {"exponent": 1.8}, shape_order=("exponent",)),
@@ -346,13 +352,13 @@ FAMILIES: dict[str, Family] = {f.effect: f for f in (
            shapes=lambda rng, motion: {"exponent": 2.5}, shape_order=("exponent",)),
     Family("end_stop", HERTZ_STOP, "k_hertz", "N/m^1.5",
            "k (|z| - gap)_+^1.5 sgn(z) (Hertzian stop), gap at a quantile of |z| drawn in "
-           "[0.75, 0.95]", "k_stop (|z| - gap_stop)_+ sgn(z)", guess=1e5,
+           "[0.7, 0.9]", "k_stop (|z| - gap_stop)_+ sgn(z)", guess=1e5,
            shapes=_stop_gap, shape_order=("gap",)),
     Family("backlash", BACKLASH, "gap", "m",
-           "gap in the screw-nut coupling; contact k_c delta^1.5 + c_c delta' (compressive), "
-           "k_c = 1e11 N/m^1.5, c_c = 300 N s/m",
+           "gap in the screw-nut coupling; Tsuji contact k_c delta^1.5 + c_c delta^0.25 delta' "
+           "(compressive), k_c = 1e11 N/m^1.5, c_c = 1e5 N s/m^1.25",
            "k_backlash dz(d, gap) (1 + 100 d'), linear with Hunt-Crossley damping", guess=2e-5,
-           shapes=lambda rng, motion: {"k_contact": 1e11, "c_contact": 300.0},
+           shapes=lambda rng, motion: {"k_contact": 1e11, "c_contact": 1e5},
            shape_order=("k_contact", "c_contact")),
     Family("hysteresis", BOUC_WEN, "F_hyst", "N",
            "Bouc-Wen n = 2: h' = (F/delta) w - beta |w||h|h - gamma w h^2, "
@@ -637,7 +643,7 @@ def make_scenario(effect: str, ratio: float, seed: int, settings: ScenarioSettin
     contribution = np.zeros(settings.n)
     raw = np.zeros(settings.n)
     if fam is not None:
-        motion = {"z": exc.decimate(z_fine)}
+        motion = {"z": exc.decimate(z_fine), "beta": device.beta}
         srng = shape_rng(settings, effect, seed)
         shape = fam.shapes(srng, motion)
         sign = float(srng.choice([-1.0, 1.0])) if fam.signed else 1.0

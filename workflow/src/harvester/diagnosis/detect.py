@@ -39,7 +39,7 @@ from harvester.diagnosis.locate import (FrequencyBands, Standardised, StateRegio
                                         TimeWindows, standardise)
 from harvester.diagnosis.signatures import Signature, motion_scale, signatures
 from harvester.diagnosis.spectral import (PASSBAND_MARGIN, Frame, Metric, Projector,
-                                          extrapolated_input_psd, noise_replicates)
+                                          noise_replicates)
 from harvester.priors import PriorSpec
 from harvester.pymc_models import default_prior
 
@@ -52,21 +52,19 @@ FAMILIES = ("library", "windows", "regions")
 class DetectionSettings:
     """Calibration and location settings.
 
-    bootstrap: noise replicates; chain_components: replicates in which the baseline is
-    re-simulated through a surrogate measurement chain (input-sensor noise and the input's
-    content above the preprocessing cut-off; 0 for stationary noise only), cycled over the
-    replicates; base_noise_fraction: share of the residual's noise level attributed to the
-    base accelerometer (0.5: two equal sensors, as rel_acc = mass - base channel);
-    alpha: false-alarm rate of the verdict; window_s: length of
+    bootstrap: noise replicates; alpha: false-alarm rate of the verdict;
+    gross_region_ratio, gross_window_ratio: a region (window) counts towards the verdict only
+    when it holds at least this many times its share of time (expected share) of the residual
+    energy, besides being significant (see :func:`detect`); window_s: length of
     the time windows (s); conflict_alpha: family-wise level of the prior-posterior conflict
     flags; conflict_data_dominated: a conflict needs posterior sd below this fraction of the
     prior sd; seed: replicates' random seed.
     """
 
     bootstrap: int = 400
-    chain_components: int = 100
-    base_noise_fraction: float = 0.5
     alpha: float = 0.05
+    gross_region_ratio: float = 1.5
+    gross_window_ratio: float = 2.0
     window_s: float = 1.0
     conflict_alpha: float = 0.01
     conflict_data_dominated: float = 0.5
@@ -186,65 +184,28 @@ def prior_conflicts(names: tuple[str, ...], samples: np.ndarray,
     return out
 
 
-def chain_replicates(state: BaselineState, frame: Frame, spectrum: np.ndarray,
-                     settings: DetectionSettings, rng: np.random.Generator) -> np.ndarray:
-    """DFTs (bootstrap, bins) of residuals of recordings made by the fitted baseline.
-
-    Each of ``chain_components`` components re-simulates the baseline at its posterior mean
-    driven by what the true input may have been: the measured base acceleration minus a
-    draw of base-sensor noise, plus a draw of the content the preprocessing low-pass removed
-    (``extrapolated_input_psd``); its measured z'' carries the same sensor noise and goes
-    through the chain. That reproduces the state-dependent parts of a correct model's
-    residual: input noise seen through the nonlinear structure, and the in-band leakage of the
-    removed content through friction. Stationary output noise with the rest of the
-    residual's spectrum (at least 10 % of it) is added to each replicate.
-    """
-    problem = state.problem
-    count = settings.bootstrap
-    n_comp = min(settings.chain_components, count)
-    if n_comp <= 0:
-        return noise_replicates(spectrum, frame, count, rng)
-    fs = 1.0 / problem.dt
-    y = problem.base_acc
-    n_rec = len(y)
-    freqs = np.fft.rfftfreq(n_rec, problem.dt)
-    band = frame.mask > 0.5
-    # base-sensor noise: white at a share of the residual's in-band level, through the chain
-    level = float(np.median(spectrum[band])) / (frame.n * np.mean(frame.taper**2))
-    sd_base = np.sqrt(settings.base_noise_fraction * level)
-    removed = None
-    if problem.lowpass_hz is not None:
-        f_in, p_in = extrapolated_input_psd(y, fs, problem.lowpass_hz)
-        gain = 1.0 / (1.0 + (freqs / problem.lowpass_hz) ** (2 * problem.filter_order))
-        removed = np.interp(freqs, f_in, p_in) * (1.0 - gain**2)
-    theta = state.theta
-    comps = np.empty((n_comp, frame.freqs.size), dtype=complex)
-    for i in range(n_comp):
-        noise_b = problem.chain(sd_base * rng.standard_normal(n_rec))
-        truth_input = y - noise_b
-        if removed is not None:
-            white = np.fft.rfft(rng.standard_normal(n_rec))
-            truth_input = truth_input + np.fft.irfft(white * np.sqrt(removed * fs / 2.0),
-                                                     n=n_rec)
-        sim = problem.simulate(theta, base_acc=truth_input)
-        acc = sim.rel_acc[0] if sim.ok[0] else state.rel_acc
-        comp = problem.chain(acc) - state.rel_acc - noise_b
-        comps[i] = frame.dft(comp)
-    simulated = frame.smoothed_mean(np.mean(np.abs(comps) ** 2, axis=0))
-    rest = np.maximum(spectrum - simulated, 0.1 * spectrum)
-    out = noise_replicates(rest, frame, count, rng)
-    out += comps[np.arange(count) % n_comp]
-    return out
+def gated_max(stats: Standardised, log_share_gate: np.ndarray) -> tuple[float, np.ndarray]:
+    """Largest z among locations whose log share of energy exceeds the gate (else -inf),
+    for the data and each replicate (whose shares are recovered from the z-scores)."""
+    obs_ok = stats.observed >= log_share_gate
+    obs = float(np.max(np.where(obs_ok, stats.z, -np.inf))) if stats.z.size else -np.inf
+    rep_ok = stats.replicate_values >= log_share_gate[None, :]
+    rep = np.max(np.where(rep_ok, stats.z_replicates, -np.inf), axis=1) if stats.z.size else \
+        np.full(stats.z_replicates.shape[0], -np.inf)
+    return obs, rep
 
 
 def _rank_p(observed: float, replicates: np.ndarray) -> float:
+    if observed == -np.inf:
+        return 1.0
     return float((1.0 + np.sum(replicates >= observed)) / (1.0 + replicates.size))
 
 
 def _replicate_p(replicates: np.ndarray) -> np.ndarray:
     """p-value of each replicate among all replicates (fraction at least as large)."""
     order = np.sort(replicates)
-    return (replicates.size - np.searchsorted(order, replicates, side="left")) / replicates.size
+    p = (replicates.size - np.searchsorted(order, replicates, side="left")) / replicates.size
+    return np.where(replicates == -np.inf, 1.0, p)
 
 
 def detect(state: BaselineState, window: tuple[int, int], priors: Mapping[str, PriorSpec],
@@ -282,7 +243,7 @@ def detect(state: BaselineState, window: tuple[int, int], priors: Mapping[str, P
         np.einsum("ij,ij->i", Gp.imag * metric.weight, Gp.imag)
 
     rng = np.random.default_rng(settings.seed)
-    reps = proj.apply(chain_replicates(state, frame, spectrum, settings, rng))
+    reps = proj.apply(noise_replicates(spectrum, frame, settings.bootstrap, rng))
     log.info("detection over %.1f-%.1f s, band %.2f-%.1f Hz, %d signatures, %d replicates",
              time[start], time[stop - 1], frame.f_low, f_high, len(sigs), settings.bootstrap)
 
@@ -326,8 +287,11 @@ def detect(state: BaselineState, window: tuple[int, int], priors: Mapping[str, P
     regions = StateRegions(frame, state.rel_disp, state.rel_vel, state.rel_acc,
                            problem.base_acc)
     r_stats = standardise(regions.statistic(series), regions.statistic(series_rep))
-    fam_obs["windows"], fam_rep["windows"] = w_stats.family_max, w_stats.family_max_replicates
-    fam_obs["regions"], fam_rep["regions"] = r_stats.family_max, r_stats.family_max_replicates
+    # a window or region enters the verdict only if it also holds a gross excess of energy
+    w_gate = np.log(settings.gross_window_ratio * windows.expected_share())
+    r_gate = np.log(settings.gross_region_ratio * regions.time_share())
+    fam_obs["windows"], fam_rep["windows"] = gated_max(w_stats, w_gate)
+    fam_obs["regions"], fam_rep["regions"] = gated_max(r_stats, r_gate)
 
     family_p = {f: _rank_p(fam_obs[f], fam_rep[f]) for f in fam_obs}
     minp_obs = min(family_p.values())

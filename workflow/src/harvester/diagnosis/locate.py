@@ -39,6 +39,7 @@ class Standardised:
     observed: np.ndarray  # (k,)
     z: np.ndarray  # (k,)
     z_replicates: np.ndarray  # (B, k)
+    replicate_values: np.ndarray  # (B, k) the replicates' statistics
 
     @property
     def family_max(self) -> float:
@@ -62,7 +63,7 @@ def standardise(observed: np.ndarray, replicates: np.ndarray) -> Standardised:
     mean = replicates.mean(axis=0)
     sd = replicates.std(axis=0, ddof=1)
     sd = np.where(sd > 0, sd, np.inf)
-    return Standardised(observed, (observed - mean) / sd, (replicates - mean) / sd)
+    return Standardised(observed, (observed - mean) / sd, (replicates - mean) / sd, replicates)
 
 
 class TimeWindows:

@@ -22,8 +22,10 @@ from scipy import ndimage, signal
 
 #: Lowest analysed frequency (Hz): below it z'' holds almost no energy (z'' ~ w^2 z).
 F_LOW_HZ = 0.1
-#: Width (Hz) of the running median that smooths the periodogram into the noise spectrum.
+#: Width (Hz) of the running median that smooths the periodogram into the noise spectrum,
+#: and the fewest DFT bins it spans (the estimate's scatter is about 1.25 / sqrt(bins)).
 SMOOTHING_HZ = 1.0
+SMOOTHING_BINS = 41
 #: Local slope (dB per octave) beyond which a roll-off is taken for an anti-alias or
 #: preprocessing low-pass rather than mechanics.
 STEEP_DB_PER_OCTAVE = 40.0
@@ -113,7 +115,7 @@ class Frame:
         return np.fft.irfft(X * self.mask, n=self.n, axis=-1)
 
     def smoothed_periodogram(self, X: np.ndarray) -> np.ndarray:
-        """Running median of |X_k|^2 over SMOOTHING_HZ, divided by ln 2 (median -> mean).
+        """Running median of |X_k|^2 over SMOOTHING_HZ (at least SMOOTHING_BINS bins), / ln 2.
 
         The median ignores narrow lines and intermittent bursts, so the estimate is the level
         of the broadband (noise) floor; zero-mean noise periodogram ordinates are exponential,
@@ -127,7 +129,7 @@ class Frame:
 
     @property
     def smoothing_bins(self) -> int:
-        return max(5, int(round(SMOOTHING_HZ * self.n / self.fs)) | 1)
+        return max(SMOOTHING_BINS, int(round(SMOOTHING_HZ * self.n / self.fs)) | 1)
 
     def smoothed_mean(self, p: np.ndarray) -> np.ndarray:
         """Running mean of a spectrum over SMOOTHING_HZ."""
@@ -195,27 +197,3 @@ def noise_replicates(spectrum: np.ndarray, frame: Frame, count: int,
     series = np.fft.irfft(white * np.sqrt(level / n), n=n, axis=-1)
     return np.fft.rfft(frame.taper * series, axis=-1)
 
-
-def extrapolated_input_psd(base_acc: np.ndarray, fs: float, cutoff_hz: float
-                           ) -> tuple[np.ndarray, np.ndarray]:
-    """(frequencies, PSD) of the base acceleration continued above a low-pass cut-off.
-
-    The preprocessing filter removed the input's content above the cut-off, and the response
-    of a nonlinear structure to it leaks into the band (the filter does not commute with
-    friction). The lost content is guessed by continuing the measured PSD's power law fitted
-    over 0.4-0.75 x the cut-off (slope clipped to [-60, 0] dB/decade: at least as much content
-    as a steep excitation filter would leave), which errs towards too much.
-    """
-    nper = int(min(len(base_acc) // 4, round(4.0 * fs)))
-    f, p = signal.welch(base_acc - np.mean(base_acc), fs=fs, nperseg=nper)
-    fit = (f >= 0.4 * cutoff_hz) & (f <= 0.75 * cutoff_hz) & (p > 0)
-    if fit.sum() < 3:
-        return f, p
-    slope, icpt = np.polyfit(np.log10(f[fit]), np.log10(p[fit]), 1)
-    slope = float(np.clip(slope, -6.0, 0.0))
-    pivot = 0.75 * cutoff_hz
-    level = 10.0 ** (icpt + slope * np.log10(pivot)) if slope == slope else p[fit][-1]
-    above = f > pivot
-    out = p.copy()
-    out[above] = level * (f[above] / pivot) ** slope
-    return f, out

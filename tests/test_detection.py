@@ -1,0 +1,225 @@
+"""Aggregation of the concealed-effect scenarios, and the workflow's SLURM profile (dry run)."""
+
+from __future__ import annotations
+
+import copy
+import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from conftest import ROOT, SNAKEMAKE
+
+from harvester import detection as det
+
+
+def _truth(effect, ratio, seed, baseline="tanh"):
+    return {"effect": effect, "ratio": ratio, "seed": seed, "baseline": baseline,
+            "contribution_ratio": ratio, "peak_to_noise": 2.0 * ratio, "invisible": True}
+
+
+def _diag(*missing):
+    return {"verdict": "missing_physics" if missing else "adequate", "missing": list(missing),
+            "p_value": 0.01 if missing else 0.5}
+
+
+def _flagged_unnamed():
+    return {"verdict": "missing_physics", "missing": [], "p_value": 0.01}
+
+
+@pytest.fixture
+def results():
+    pairs = [
+        # end_stop at 0.5: named, named, second, passed
+        (_truth("end_stop", 0.5, 0), _diag("end_stop", "cubic_stiffness")),
+        (_truth("end_stop", 0.5, 1), _diag("end_stop")),
+        (_truth("end_stop", 0.5, 2), _diag("cubic_stiffness", "end_stop")),
+        (_truth("end_stop", 0.5, 3), _diag()),
+        # end_stop at 1.0: all named
+        (_truth("end_stop", 1.0, 0), _diag("end_stop")),
+        (_truth("end_stop", 1.0, 1), _diag("end_stop")),
+        # coulomb on the linear baseline: tanh_friction is accepted; stribeck is not
+        (_truth("coulomb_friction", 0.5, 0, "linear"), _diag("tanh_friction", "coulomb_friction")),
+        (_truth("coulomb_friction", 0.5, 1, "linear"), _diag("stribeck_friction")),
+        (_truth("coulomb_friction", 0.5, 2, "linear"), _flagged_unnamed()),
+        # effect-free: 1 alarm in 4 (tanh), 0 in 2 (linear)
+        (_truth("none_tanh", 0.0, 0), _diag()),
+        (_truth("none_tanh", 0.0, 1), _diag("backlash")),
+        (_truth("none_tanh", 0.0, 2), _diag()),
+        (_truth("none_tanh", 0.0, 3), _diag()),
+        (_truth("none_linear", 0.0, 0, "linear"), _diag()),
+        (_truth("none_linear", 0.0, 1, "linear"), _diag()),
+    ]
+    return det.results_table(pairs)
+
+
+def test_wilson_interval_matches_known_values():
+    lo, hi = det.wilson_interval(9, 10)
+    assert (lo, hi) == pytest.approx((0.59585, 0.98212), abs=1e-4)
+    lo, hi = det.wilson_interval(0, 20)
+    assert lo == pytest.approx(0.0, abs=1e-12) and hi == pytest.approx(0.16113, abs=1e-4)
+    lo, hi = det.wilson_interval(np.array([20, 5]), np.array([20, 10]))
+    assert hi[0] == pytest.approx(1.0) and lo[1] < 0.5 < hi[1]
+
+
+def test_detection_table_rates(results):
+    table = det.detection_table(results).set_index(["effect", "ratio"])
+    row = table.loc[("end_stop", 0.5)]
+    assert (row["seeds"], row["named"], row["named_rate"]) == (4, 2, 0.5)
+    assert row["top2_rate"] == 0.75 and row["flagged_rate"] == 0.75
+    assert row["meets_goal"] is False or row["meets_goal"] == False  # noqa: E712
+    assert row["most_named_instead"] in ("cubic_stiffness", "adequate")
+    row = table.loc[("end_stop", 1.0)]
+    assert row["named_rate"] == 1.0 and row["meets_goal"] is None  # goal only at 0.5
+    row = table.loc[("coulomb_friction", 0.5)]
+    assert row["named"] == 1 and row["top2_rate"] == pytest.approx(1 / 3)
+    assert row["baseline"] == "linear"
+    assert row["named_lo"] < row["named_rate"] < row["named_hi"]
+    assert ("none_tanh", 0.0) not in table.index
+
+
+def test_accepted_names_can_be_configured(results):
+    strict = det.results_table(
+        [(_truth("coulomb_friction", 0.5, 0, "linear"), _diag("tanh_friction"))], accepted={})
+    assert not strict["named"].iloc[0]
+    loose = det.results_table(
+        [(_truth("coulomb_friction", 0.5, 0, "linear"), _diag("tanh_friction"))])
+    assert loose["named"].iloc[0]
+
+
+def test_confusion_matrix(results):
+    cm = det.confusion_matrix(results)
+    assert list(cm.columns[:4]) == ["ratio", "true_effect", "adequate", "unnamed"]
+    row = cm[(cm["ratio"] == "0.5") & (cm["true_effect"] == "end_stop")].iloc[0]
+    assert (row["end_stop"], row["cubic_stiffness"], row["adequate"]) == (2, 1, 1)
+    row = cm[(cm["ratio"] == "all") & (cm["true_effect"] == "end_stop")].iloc[0]
+    assert row["end_stop"] == 4 and row.drop(["ratio", "true_effect"]).sum() == 6
+    row = cm[(cm["ratio"] == "0.5") & (cm["true_effect"] == "coulomb_friction")].iloc[0]
+    assert (row["tanh_friction"], row["stribeck_friction"], row["unnamed"]) == (1, 1, 1)
+    row = cm[(cm["ratio"] == "0") & (cm["true_effect"] == "none_tanh")].iloc[0]
+    assert (row["adequate"], row["backlash"]) == (3, 1)
+    assert "none_tanh" not in set(cm.loc[cm["ratio"] == "all", "true_effect"])
+    # every scenario counted once per its ratio
+    per_ratio = cm[cm["ratio"] != "all"].drop(columns=["ratio", "true_effect"]).to_numpy().sum()
+    assert per_ratio == len(results)
+
+
+def test_false_alarms(results):
+    fa = det.false_alarms(results).set_index("baseline")
+    assert (fa.loc["tanh", "scenarios"], fa.loc["tanh", "false_alarms"]) == (4, 1)
+    assert fa.loc["linear", "rate"] == 0.0 and fa.loc["linear", "meets_goal"]
+    assert fa.loc["all", "rate"] == pytest.approx(1 / 6)
+    assert not fa.loc["all", "meets_goal"] and not fa.loc["all", "goal_certain"]
+    assert fa.loc["tanh", "named_on_false_alarm"] == "backlash"
+
+
+def test_figure(results, tmp_path):
+    path = tmp_path / "rates.png"
+    det.detection_figure(det.detection_table(results), det.false_alarms(results), path)
+    assert path.stat().st_size > 10_000
+
+
+def test_scenario_grid_from_config():
+    cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())["detection"]
+    small = det.scenario_grid(cfg)
+    g = cfg["grids"]["small"]
+    assert len(small) == (len(g["effects"]) * len(g["ratios"]) * g["seeds"]
+                          + len(g["effect_free"]) * g["false_alarm_seeds"])
+    full = det.scenario_grid({**cfg, "grid": "full"})
+    assert {e for e, r, s in full if r != "0"} == set(cfg["effects"])
+    assert ("end_stop", "0.25", 19) in full and ("none_linear", "0", 99) in full
+
+
+# --------------------------------------------------------------------------- workflow
+
+
+def _small_detection_config() -> dict:
+    cfg = copy.deepcopy(yaml.safe_load((ROOT / "config/config.yaml").read_text()))
+    cfg["detection"]["grid"] = "small"
+    cfg["detection"]["grids"]["small"].update(
+        effects=["end_stop", "coulomb_friction"], ratios=[0.5], seeds=1,
+        effect_free=["none_tanh"], false_alarm_seeds=1, duration_s=6.0, fast=True)
+    return cfg
+
+
+def _workdir(tmp_path: Path, cfg: dict) -> tuple[Path, Path]:
+    """A working directory with the config, and a Snakefile that includes detection.smk
+    (the repository's own Snakefile once it includes it)."""
+    (tmp_path / "config.yaml").write_text(yaml.safe_dump(cfg))
+    snakefile = ROOT / "Snakefile"
+    if "rules/detection.smk" not in snakefile.read_text():
+        wrapper = tmp_path / "Snakefile"
+        wrapper.write_text(f'include: "{snakefile}"\n'
+                           f'include: "{ROOT / "workflow/rules/detection.smk"}"\n')
+        snakefile = wrapper
+    return tmp_path, snakefile
+
+
+def _fake_slurm(bin_dir: Path, marker: Path) -> dict:
+    """sbatch/sinfo/squeue that record being called and fail: a dry run must not call them."""
+    bin_dir.mkdir()
+    for tool in ("sbatch", "sinfo", "squeue", "sacct", "scancel"):
+        script = bin_dir / tool
+        script.write_text(f"#!/bin/sh\necho {tool} >> {marker}\nexit 1\n")
+        script.chmod(0o755)
+    return dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}",
+                PYTHONWARNINGS="ignore")
+
+
+def test_slurm_profile_dry_run_shows_rules_and_resources(tmp_path):
+    workdir, snakefile = _workdir(tmp_path, _small_detection_config())
+    marker = tmp_path / "called.txt"
+    env = _fake_slurm(tmp_path / "bin", marker)
+    cmd = [str(SNAKEMAKE), "--profile", str(ROOT / "profiles/slurm"), "-n", "detection_all",
+           "-s", str(snakefile), "-d", str(workdir), "--configfile", str(workdir / "config.yaml")]
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=300)
+    out = proc.stdout + proc.stderr
+    assert proc.returncode == 0, out[-4000:]
+    assert not marker.exists(), marker.read_text()
+    for rule, count in (("detection_scenario", 3), ("diagnose_scenario", 3),
+                        ("detection_table", 1), ("detection_figure", 1), ("detection_all", 1)):
+        assert any(line.split() == [rule, str(count)] for line in out.splitlines()), rule
+    profile = yaml.safe_load((ROOT / "profiles/slurm/config.yaml").read_text())
+    assert profile["executor"] == "slurm"
+    for rule in ("diagnose_scenario", "detection_scenario", "detection_table"):
+        shown = _job_resources(out, rule)
+        assert len(shown) == {"diagnose_scenario": 3, "detection_scenario": 3}.get(rule, 1)
+        for key, value in profile["set-resources"][rule].items():
+            assert all(r[key] == str(value) for r in shown), (rule, key, shown[0])
+        assert all(r["slurm_partition"] and r["slurm_account"] for r in shown)
+
+
+def _job_resources(dry_run: str, rule: str) -> list[dict[str, str]]:
+    """The resources line of each job of ``rule`` in a dry run's output, as a dict."""
+    out = []
+    for block in dry_run.split("\nrule ")[1:]:
+        if not block.startswith(f"{rule}:"):
+            continue
+        line = next(ln for ln in block.splitlines() if ln.strip().startswith("resources:"))
+        pairs = line.split(":", 1)[1].split(", ")
+        out.append(dict(p.strip().split("=", 1) for p in pairs))
+    return out
+
+
+@pytest.mark.slow
+def test_small_grid_runs_end_to_end(tmp_path):
+    """The local run: scenarios, diagnoses, tables, figure (about a minute on two cores)."""
+    workdir, snakefile = _workdir(tmp_path, _small_detection_config())
+    cmd = [str(SNAKEMAKE), "detection_all", "-s", str(snakefile), "-d", str(workdir),
+           "--configfile", str(workdir / "config.yaml"), "--cores", "2", "--quiet", "rules"]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=1800,
+                          env=dict(os.environ, PYTHONWARNINGS="ignore"))
+    assert proc.returncode == 0, (proc.stdout + proc.stderr)[-6000:]
+    d = workdir / "results/detection"
+    table = pd.read_csv(d / "detection_table.csv")
+    assert set(table["effect"]) == {"end_stop", "coulomb_friction"}
+    assert (table["seeds"] == 1).all()
+    alarms = pd.read_csv(d / "false_alarms.csv")
+    assert alarms.loc[alarms["baseline"] == "all", "scenarios"].iloc[0] == 1
+    assert (d / "figures/detection_rates.png").stat().st_size > 10_000
+    res = pd.read_csv(d / "scenario_results.csv")
+    assert np.allclose(res.loc[~res["effect_free"], "contribution_ratio"], 0.5, rtol=0.01)
