@@ -27,6 +27,9 @@ test-slow: $(STAMP)
 benchmark: $(STAMP)
 	$(BIN)/python benchmarks/bench_tmcmc.py
 
+detection: $(STAMP)
+	$(BIN)/snakemake --cores $(CORES) detection_all
+
 dag: $(STAMP)
 	$(BIN)/snakemake -n all
 

@@ -20,8 +20,7 @@ from harvester.simulate import simulate
 
 ROOT = Path(__file__).parents[1]
 CFG = yaml.safe_load((ROOT / "config/config.yaml").read_text())["emps"]
-TRAINING, VALIDATION = Path(CFG["training"]), Path(CFG["validation"])
-pytestmark = pytest.mark.skipif(not TRAINING.is_file(), reason="EMPS data not available")
+TRAINING, VALIDATION = ROOT / CFG["training"], ROOT / CFG["validation"]
 #: Published parameters in our layout order for the model viscous + coulomb_friction.
 MODEL = emps.BASELINE_TERMS + ("coulomb_friction",)
 

@@ -10,7 +10,7 @@ import pytest
 import yaml
 
 from harvester.errors import DataError
-from harvester.signals import filter_recording, filter_response_db, frf_h1, lowpass, psd
+from harvester.signals import CHANNELS, filter_recording, filter_response_db, frf_h1, lowpass, psd
 
 CONFIG = yaml.safe_load((Path(__file__).parents[1] / "config" / "config.yaml").read_text())
 FS = float(CONFIG["rig"]["daq"]["sampling_rate_hz"])
@@ -48,7 +48,7 @@ def test_analytic_response_passes_0_to_10hz_within_half_db() -> None:
 
 
 def test_measured_attenuation_on_tones(two_tones: pd.DataFrame) -> None:
-    out = filter_recording(two_tones, CUTOFF, ORDER)
+    out = filter_recording(two_tones, CUTOFF, ORDER, channels=CHANNELS)
     t = out["time"].to_numpy()
     mid = (t > 2.0) & (t < 18.0)
     for channel in ("base_acc", "rel_acc"):
@@ -71,7 +71,7 @@ def test_zero_phase_no_delay(two_tones: pd.DataFrame) -> None:
 
 
 def test_same_filter_on_both_channels(two_tones: pd.DataFrame) -> None:
-    out = filter_recording(two_tones, CUTOFF, ORDER)
+    out = filter_recording(two_tones, CUTOFF, ORDER, channels=CHANNELS)
     np.testing.assert_array_equal(out["base_acc"], out["rel_acc"])
     np.testing.assert_array_equal(out["time"], two_tones["time"])
 
@@ -100,8 +100,14 @@ def test_h1_of_a_gain_with_output_noise() -> None:
 def test_data_figures_are_written(two_tones: pd.DataFrame, tmp_path: Path) -> None:
     from harvester.figures_data import fig04_psd, fig05_time_history
 
-    out = filter_recording(two_tones, CUTOFF, ORDER)
+    out = filter_recording(two_tones, CUTOFF, ORDER, channels=CHANNELS)
     fig04_psd(two_tones, out, FS, CUTOFF, tmp_path / "fig04.png")
     fig05_time_history(two_tones, out, tmp_path / "fig05.png", window=(2.0, 4.0))
     assert (tmp_path / "fig04.png").stat().st_size > 10_000
     assert (tmp_path / "fig05.png").stat().st_size > 10_000
+
+
+def test_default_filters_the_output_only(two_tones: pd.DataFrame) -> None:
+    out = filter_recording(two_tones, CUTOFF, ORDER)
+    np.testing.assert_array_equal(out["base_acc"], two_tones["base_acc"])
+    assert not np.allclose(out["rel_acc"], two_tones["rel_acc"])

@@ -1,4 +1,6 @@
 # Shared helpers: paths of the study's files, target lists.
+# Conda environment of every rule (used with --use-conda; `make study` uses .venv instead).
+ENV = "../../envs/harvester.yaml"
 RECORDS = ["training", "validation"]
 RAW = config["data"]["raw_dir"]
 MODELS = config["models"]

@@ -8,6 +8,8 @@ rule regenerate_raw_data:
         rig=config["rig"],
     log:
         "logs/regenerate_raw_data.log",
+    conda:
+        ENV
     script:
         "../scripts/make_raw_data.py"
 
@@ -20,6 +22,8 @@ rule check_raw_reproduced:
         "results/checks/raw_reproduced.txt",
     log:
         "logs/check_raw_reproduced.log",
+    conda:
+        ENV
     script:
         "../scripts/check_reproduced.py"
 
@@ -33,6 +37,8 @@ rule verify_checksums:
         "results/checks/raw_checksums.txt",
     log:
         "logs/verify_checksums.log",
+    conda:
+        ENV
     script:
         "../scripts/verify_checksums.py"
 
@@ -47,5 +53,7 @@ rule convert:
         record="|".join(RECORDS),
     log:
         "logs/convert_{record}.log",
+    conda:
+        ENV
     script:
         "../scripts/convert.py"

@@ -61,6 +61,8 @@ rule detection_scenario:
         runtime=10,
     log:
         "logs/detection/scenario_{effect}_r{ratio}_s{seed}.log",
+    conda:
+        ENV
     script:
         "../scripts/detection_scenario.py"
 
@@ -82,6 +84,8 @@ rule diagnose_scenario:
         runtime=lambda w: 15 if detection_grid()["fast"] else 60,
     log:
         "logs/detection/diagnose_{effect}_r{ratio}_s{seed}.log",
+    conda:
+        ENV
     script:
         "../scripts/detection_diagnose.py"
 
@@ -104,6 +108,8 @@ rule detection_table:
         goal=lambda w: DETECTION["goal"],
     log:
         "logs/detection/table.log",
+    conda:
+        ENV
     script:
         "../scripts/detection_table.py"
 
@@ -119,5 +125,7 @@ rule detection_figure:
         goal=lambda w: DETECTION["goal"],
     log:
         "logs/detection/figure.log",
+    conda:
+        ENV
     script:
         "../scripts/detection_figure.py"

@@ -41,6 +41,8 @@ rule emps_data:
         sha256=EMPS["sha256"],
     log:
         "logs/emps/data.log",
+    conda:
+        ENV
     script:
         "../scripts/emps_data.py"
 
@@ -62,6 +64,8 @@ rule emps_initial:
         temper=EMPS["temper"],
     log:
         "logs/emps/initial.log",
+    conda:
+        ENV
     script:
         "../scripts/emps_initial.py"
 
@@ -83,6 +87,8 @@ rule emps_tmcmc:
         runtime=60,
     log:
         "logs/emps/tmcmc_{model}.log",
+    conda:
+        ENV
     script:
         "../scripts/emps_tmcmc.py"
 
@@ -101,6 +107,8 @@ rule emps_diagnosis:
         extended=EMPS["extended"],
     log:
         "logs/emps/diagnosis.log",
+    conda:
+        ENV
     script:
         "../scripts/emps_diagnosis.py"
 
@@ -119,6 +127,8 @@ rule emps_parameters:
                       category="EMPS", subcategory="4. Parameters"),
     log:
         "logs/emps/parameters.log",
+    conda:
+        ENV
     script:
         "../scripts/emps_parameters.py"
 
@@ -139,6 +149,8 @@ rule emps_predictive:
     threads: 2
     log:
         "logs/emps/predictive_{model}_{record}.log",
+    conda:
+        ENV
     script:
         "../scripts/emps_predictive.py"
 
@@ -152,6 +164,8 @@ rule emps_validation:
                category="EMPS", subcategory="5. Validation"),
     log:
         "logs/emps/validation.log",
+    conda:
+        ENV
     script:
         "../scripts/emps_validation.py"
 
@@ -176,6 +190,8 @@ rule emps_tracking_figure:
                          else "Unseen record DATA_EMPS_PULSES (force pulses added)"),
     log:
         "logs/emps/tracking_figure_{record}.log",
+    conda:
+        ENV
     script:
         "../scripts/emps_tracking_figure.py"
 
@@ -197,5 +213,7 @@ rule emps_headline:
         extended=EMPS_EXTENDED,
     log:
         "logs/emps/headline.log",
+    conda:
+        ENV
     script:
         "../scripts/emps_headline.py"

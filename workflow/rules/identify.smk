@@ -20,6 +20,8 @@ rule tmcmc:
         runtime=60,
     log:
         "logs/tmcmc_{model}.log",
+    conda:
+        ENV
     script:
         "../scripts/tmcmc.py"
 
@@ -37,6 +39,8 @@ rule posterior_table:
         rig=config["rig"],
     log:
         "logs/posterior_table_{table}_{model}.log",
+    conda:
+        ENV
     script:
         "../scripts/posterior_table.py"
 
@@ -53,6 +57,8 @@ rule posterior_figure:
         rig=config["rig"],
     log:
         "logs/posterior_figure_{fig}_{model}.log",
+    conda:
+        ENV
     script:
         "../scripts/posterior_figure.py"
 
@@ -69,5 +75,7 @@ rule evidence:
         models=MODELS,
     log:
         "logs/evidence.log",
+    conda:
+        ENV
     script:
         "../scripts/evidence.py"

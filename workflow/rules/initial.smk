@@ -12,6 +12,8 @@ rule static_friction:
         k=config["rig"]["k"],
     log:
         "logs/static_friction.log",
+    conda:
+        ENV
     script:
         "../scripts/static_friction.py"
 
@@ -31,6 +33,8 @@ rule damping_fit:
         samples=config["preprocess"]["training_samples"],
     log:
         "logs/damping_fit.log",
+    conda:
+        ENV
     script:
         "../scripts/damping_fit.py"
 
@@ -53,5 +57,7 @@ rule table1:
         priors=config["priors"],
     log:
         "logs/table1.log",
+    conda:
+        ENV
     script:
         "../scripts/table1.py"

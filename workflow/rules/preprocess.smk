@@ -11,6 +11,8 @@ rule lowpass:
         order=config["preprocess"]["filter_order"],
     log:
         "logs/lowpass_{record}.log",
+    conda:
+        ENV
     script:
         "../scripts/lowpass.py"
 
@@ -25,6 +27,8 @@ rule fig04_psd:
         cutoff=config["preprocess"]["lowpass_hz"],
     log:
         "logs/fig04_psd.log",
+    conda:
+        ENV
     script:
         "../scripts/fig04_psd.py"
 
@@ -40,5 +44,7 @@ rule fig05_time_history:
         samples=config["preprocess"]["training_samples"],
     log:
         "logs/fig05_time_history.log",
+    conda:
+        ENV
     script:
         "../scripts/fig05_time_history.py"

@@ -15,5 +15,7 @@ rule headline:
         models=MODELS,
     log:
         "logs/headline.log",
+    conda:
+        ENV
     script:
         "../scripts/headline.py"

@@ -17,6 +17,8 @@ rule predictive:
     threads: 2
     log:
         "logs/predictive_{model}_{record}.log",
+    conda:
+        ENV
     script:
         "../scripts/predictive.py"
 
@@ -29,6 +31,8 @@ rule validation_table:
                category="Validation"),
     log:
         "logs/validation_table.log",
+    conda:
+        ENV
     script:
         "../scripts/validation_table.py"
 
@@ -44,6 +48,8 @@ rule fig07_linear_training:
         window=None,
     log:
         "logs/fig07.log",
+    conda:
+        ENV
     script:
         "../scripts/response_figure.py"
 
@@ -59,6 +65,8 @@ rule fig09_tanh_unseen_section:
         window=config["predictive"]["short_window_s"],
     log:
         "logs/fig09.log",
+    conda:
+        ENV
     script:
         "../scripts/response_figure.py"
 
@@ -74,5 +82,7 @@ rule fig10_tanh_unseen_full:
         window=None,
     log:
         "logs/fig10.log",
+    conda:
+        ENV
     script:
         "../scripts/response_figure.py"

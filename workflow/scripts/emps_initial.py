@@ -1,4 +1,4 @@
-"""Rule emps_initial: priors of M and Fv from the instrumented FRF fit; config priors for the rest."""
+"""Rule emps_initial: priors of M and Fv from the instrumented FRF fit, the rest from config."""
 
 from dataclasses import asdict
 

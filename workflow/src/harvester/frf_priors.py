@@ -48,7 +48,7 @@ from harvester.priors import PriorSpec
 from harvester.recording import RecordingKinds, check_scale, input_output
 
 #: Default relative prior sd of each base parameter (fraction of the fitted value).
-REL_SD: dict[str, float] = {"M": 0.25, "m": 0.25, "k": 0.25, "c_m": 0.5}
+REL_SD: dict[str, float] = {"M": 0.25, "m": 0.25, "k": 0.5, "c_m": 0.5}
 #: Coherence is clipped at this value for the weights gamma^2 / (1 - gamma^2).
 MAX_COHERENCE = 0.99
 #: Lines with coherence below this are left out of the fit.

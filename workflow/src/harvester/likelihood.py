@@ -64,7 +64,8 @@ class Problem:
         start, stop = self.window or (0, len(self.output))
         self.window = (int(start), int(stop))
         if not 0 <= start < stop <= len(self.output):
-            raise ValueError(f"window {self.window} outside the record of {len(self.output)} samples")
+            raise ValueError(f"window {self.window} outside the record of {len(self.output)} "
+                             "samples")
         self.stride = int(self.stride)
         if self.stride < 1:
             raise ValueError(f"stride must be a positive integer, got {self.stride}")
@@ -75,7 +76,8 @@ class Problem:
 
     def _check_kinds(self) -> None:
         if self.input_kind not in INPUT_KINDS:
-            raise ValueError(f"input_kind must be one of {list(INPUT_KINDS)}, got {self.input_kind!r}")
+            raise ValueError(f"input_kind must be one of {list(INPUT_KINDS)}, "
+                             f"got {self.input_kind!r}")
         if self.output_kind not in OUTPUT_KINDS:
             raise ValueError(f"output_kind must be one of {list(OUTPUT_KINDS)}, "
                              f"got {self.output_kind!r}")
@@ -152,7 +154,7 @@ class Problem:
         return dataclasses.replace(self, **changes)
 
     def loglike(self, theta: np.ndarray) -> np.ndarray:
-        """Log-likelihood, eq. (10) x ``temper``, for each row of theta; -inf where simulation failed.
+        """Log-likelihood, eq. (10) x ``temper``, per row of theta; -inf where simulation failed.
 
         ``temper`` < 1 is the power likelihood L ** temper: with residuals correlated over
         tau samples, temper = 1 / tau counts each independent piece of information once.

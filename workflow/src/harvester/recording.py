@@ -71,8 +71,8 @@ _NON_SI = {
 }
 _SI = {"m/s^2", "m/s2", "ms-2", "m/s/s", "m", "n"}
 _ANNOTATED = re.compile(
-    r"^\s*(?P<kind>base_acc|force|rel_acc|rel_disp)[\s_\-]*[\[(]?\s*(?P<unit>[^\])\s]+)\s*[\])]?\s*$",
-    re.IGNORECASE)
+    r"^\s*(?P<kind>base_acc|force|rel_acc|rel_disp)[\s_\-]*[\[(]?\s*"
+    r"(?P<unit>[^\])\s]+)\s*[\])]?\s*$", re.IGNORECASE)
 
 
 @dataclass(frozen=True)

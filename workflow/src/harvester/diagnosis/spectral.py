@@ -29,8 +29,6 @@ SMOOTHING_BINS = 41
 #: Local slope (dB per octave) beyond which a roll-off is taken for an anti-alias or
 #: preprocessing low-pass rather than mechanics.
 STEEP_DB_PER_OCTAVE = 40.0
-#: Fraction of the detected passband edge kept (steep filters roll off just below it).
-PASSBAND_MARGIN = 0.9
 #: Fraction of the window tapered (Tukey) to avoid leakage from the window's edges.
 TAPER_FRACTION = 0.1
 
@@ -183,17 +181,40 @@ class Projector:
 
 
 def noise_replicates(spectrum: np.ndarray, frame: Frame, count: int,
-                     rng: np.random.Generator) -> np.ndarray:
-    """DFTs (count, bins) of stationary Gaussian noise with the given periodogram level.
+                     rng: np.random.Generator, envelope: np.ndarray | None = None
+                     ) -> np.ndarray:
+    """DFTs (count, bins) of Gaussian noise with the given periodogram level.
 
     ``spectrum`` is the expected |dft(x)|^2 of the tapered window (as
     :meth:`Frame.smoothed_periodogram` estimates it). Each replicate is generated as a whole
-    series, then tapered and transformed like the data, so edge effects and bin correlations
-    match.
+    series, optionally multiplied by a slowly varying ``envelope`` (n,) of mean square 1 (noise
+    whose level drifts with time, as the residual's does), then tapered and transformed like
+    the data, so edge effects and bin correlations match.
     """
     n = frame.n
     level = spectrum / np.mean(frame.taper**2)
+    # the spectrum is itself an estimate: each replicate draws its own, scattered about it
+    # as a running median of SMOOTHING_BINS periodogram ordinates scatters (~1.25/sqrt(bins))
+    width = frame.smoothing_bins
+    scatter = 1.25 * ndimage.uniform_filter1d(rng.standard_normal((count, level.size)), width,
+                                              axis=-1, mode="nearest")
+    level = level * np.exp(scatter - 0.5 * np.var(scatter))
     white = np.fft.rfft(rng.standard_normal((count, n)), axis=-1)
     series = np.fft.irfft(white * np.sqrt(level / n), n=n, axis=-1)
+    if envelope is not None:
+        series *= envelope
     return np.fft.rfft(frame.taper * series, axis=-1)
 
+
+def level_envelope(x: np.ndarray, fs: float, seconds: float = 1.0) -> np.ndarray:
+    """Slowly varying RMS level of x (Hann-weighted moving average of x^2 over ``seconds``),
+    scaled to mean square 1."""
+    width = max(3, int(round(seconds * fs)))
+    kernel = np.hanning(width + 2)[1:-1]
+    kernel /= kernel.sum()
+    power = np.convolve(np.asarray(x, dtype=float) ** 2, kernel, mode="same")
+    # edges: the kernel is cut, renormalise by its mass inside
+    mass = np.convolve(np.ones_like(power), kernel, mode="same")
+    power = power / np.maximum(mass, 1e-12)
+    power = np.maximum(power, 1e-6 * max(float(np.mean(power)), 1e-300))
+    return np.sqrt(power / np.mean(power))

@@ -67,3 +67,63 @@ def measured_recording(terms: tuple[str, ...], values: Mapping[str, float], dura
         clean_f = clean
     df = pd.DataFrame({"time": np.arange(n) / fs, "base_acc": base, "rel_acc": rel})
     return df, clean_f
+
+
+#: Effects hidden in the tests' recordings: (term, strength parameter, other parameters).
+#: The end stop's clearance is set from the baseline's motion (``gap_quantile`` of |z|).
+CONCEALED: dict[str, tuple[str, dict[str, float]]] = {
+    "end_stop": ("k_stop", {"gap_stop": float("nan")}),
+    "cubic_stiffness": ("k_cubic", {}),
+    "unmodelled_mode": ("mass_mode", {"f_mode": 8.0, "zeta_mode": 0.05}),
+    "quadratic_damping": ("c_quad", {}),
+    "asymmetric_friction": ("F_asym", {}),
+    "stribeck_friction": ("F_stribeck", {"v_stribeck": 0.01}),
+    "coulomb_friction": ("F_coulomb", {}),
+    "inertia_error": ("dM", {}),
+}
+
+
+def concealed_recording(effect: str, relative_rms: float, seed: int, duration_s: float = 20.0,
+                        baseline: tuple[str, ...] = ("tanh_friction",),
+                        baseline_values: Mapping[str, float] | None = None,
+                        noise_m_s2: float = 0.04, gap_quantile: float = 0.85,
+                        **chain) -> tuple[pd.DataFrame, dict[str, float]]:
+    """A recording of the baseline plus one effect whose contribution is ``relative_rms``
+    times the RMS of the measurement noise in the recording (both after the chain's filter).
+
+    The strength is found by scaling a probe (the contribution is close to linear in it) and
+    checked; returns (recording, info with strength, effect_rms, noise_rms).
+    """
+    strength_name, shape = CONCEALED[effect]
+    values = {**TABLE1_KNOWN, **TANH_TABLE5, **(baseline_values or {})}
+    fs = float(chain.get("fs", 256.0))
+    df0, clean0 = measured_recording(baseline, values, duration_s, seed, noise_m_s2=noise_m_s2,
+                                     **chain)
+    shape = dict(shape)
+    if "gap_stop" in shape:
+        layout = Layout.of(baseline)
+        n = int(round(duration_s * fs))
+        y = base_excitation(n, fs, np.random.default_rng(seed))
+        z = simulate(layout, np.array([values[p] for p in layout.parameter_names]), y,
+                     1.0 / fs).rel_disp[0]
+        shape["gap_stop"] = float(np.quantile(np.abs(z - np.median(z)), gap_quantile))
+    noise_rms = float(np.std(df0["rel_acc"].to_numpy() - clean0))
+
+    def contribution(a: float) -> tuple[pd.DataFrame, float]:
+        vals = {**values, **shape, strength_name: a}
+        df, clean = measured_recording(baseline + (effect,), vals, duration_s, seed,
+                                       noise_m_s2=noise_m_s2, **chain)
+        return df, float(np.std(clean - clean0))
+
+    probe = {"k_stop": 2000.0, "k_cubic": 2e4, "mass_mode": 0.05, "c_quad": 50.0,
+             "F_asym": 0.5, "F_stribeck": 1.0, "F_coulomb": 1.0, "dM": 0.2}[strength_name]
+    strength = probe
+    for _ in range(3):
+        df, rms = contribution(strength)
+        if rms <= 0:
+            raise RuntimeError(f"{effect} at {strength} changes nothing")
+        if abs(rms / (relative_rms * noise_rms) - 1.0) < 0.05:
+            break
+        strength *= relative_rms * noise_rms / rms
+    df, rms = contribution(strength)
+    return df, {"strength": strength, "effect_rms": rms, "noise_rms": noise_rms, **shape}
