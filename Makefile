@@ -15,8 +15,11 @@ $(STAMP): requirements.txt pyproject.toml
 	touch $@
 
 study: $(STAMP)
-	$(BIN)/snakemake --cores $(CORES) --printshellcmds all
-	$(BIN)/snakemake --cores $(CORES) all --report results/report.html
+	$(BIN)/snakemake --cores $(CORES) all emps_all
+	$(BIN)/snakemake --cores $(CORES) all emps_all --report results/report.html
+
+emps: $(STAMP)
+	$(BIN)/snakemake --cores $(CORES) emps_all
 
 test: $(STAMP)
 	$(BIN)/python -m pytest

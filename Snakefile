@@ -20,6 +20,7 @@ include: "workflow/rules/identify.smk"
 include: "workflow/rules/validate.smk"
 include: "workflow/rules/summary.smk"
 include: "workflow/rules/detection.smk"
+include: "workflow/rules/emps.smk"
 
 
 rule all:

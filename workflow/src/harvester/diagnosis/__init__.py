@@ -1,0 +1,18 @@
+"""Diagnosis of missing physics (issue 5): detect and locate a mismatch between a recording
+and a baseline model, name it from the physics library, confirm it by evidence, and show the
+fit improve.
+
+Entry points: :func:`diagnose` (one recording), :func:`diagnose_study` (the study's rule),
+:class:`DiagnosisSettings` (``DiagnosisSettings.fast()`` for grids). Modules, in the order the
+diagnosis runs: ``baseline`` (likelihood through the measurement chain, MAP, sensitivities),
+``spectral`` (frame, noise spectrum, replicates), ``signatures`` (candidate effects' output
+signatures), ``detect`` (calibrated score tests, prior conflicts), ``locate`` (time windows,
+state regions, frequency bands), ``rank``, ``confirm`` (TMCMC, evidence), ``report``
+(unseen-data fit, diagnosis.json), ``figures``, ``synthetic`` (recordings for calibration).
+"""
+
+from harvester.diagnosis.run import (Diagnosis, DiagnosisSettings, check_recording, diagnose,
+                                     diagnose_study, write)
+
+__all__ = ["Diagnosis", "DiagnosisSettings", "check_recording", "diagnose", "diagnose_study",
+           "write"]

@@ -218,3 +218,33 @@ def level_envelope(x: np.ndarray, fs: float, seconds: float = 1.0) -> np.ndarray
     power = power / np.maximum(mass, 1e-12)
     power = np.maximum(power, 1e-6 * max(float(np.mean(power)), 1e-300))
     return np.sqrt(power / np.mean(power))
+
+
+def removed_input_psd(base_acc: np.ndarray, fs: float, cutoff_hz: float, order: int
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """(frequencies, PSD) of what a zero-phase low-pass at ``cutoff_hz`` removed from the input.
+
+    The base acceleration's PSD is divided by the filter's power response where that is
+    above 0.3, its log-log slope over the top of that range is continued beyond it (clipped
+    to [-100, 0] dB per decade, so that it errs towards too much content), and the result is
+    weighted by 1 - |H|^4, the share the filter took away.
+    """
+    x = np.asarray(base_acc, dtype=float)
+    nper = int(min(len(x) // 4, round(4.0 * fs)))
+    f, p = signal.welch(x - x.mean(), fs=fs, nperseg=nper)
+    h4 = (1.0 / (1.0 + (np.maximum(f, 0.0) / cutoff_hz) ** (2 * order))) ** 2
+    trusted = (h4 > 0.3) & (f > 0)
+    unfiltered = np.where(trusted, p / np.maximum(h4, 1e-12), 0.0)
+    top = np.flatnonzero(trusted)
+    if top.size < 4:
+        return f, np.zeros_like(f)
+    fit = top[f[top] >= 0.7 * f[top[-1]]]
+    if fit.size < 3:
+        fit = top[-3:]
+    slope, icpt = np.polyfit(np.log10(f[fit]), np.log10(np.maximum(unfiltered[fit], 1e-300)), 1)
+    slope = float(np.clip(slope, -10.0, 0.0))
+    pivot = f[top[-1]]
+    level = 10.0 ** (icpt + slope * np.log10(pivot))
+    beyond = f > pivot
+    unfiltered[beyond] = level * (f[beyond] / pivot) ** slope
+    return f, unfiltered * (1.0 - h4)

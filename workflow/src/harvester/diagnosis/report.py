@@ -1,0 +1,189 @@
+"""Fit on unseen data before and after, and the diagnosis as a JSON-ready dictionary."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from harvester.diagnosis.baseline import ChainProblem
+from harvester.predictive import nrmse, outside_fraction, thin
+
+
+@dataclass
+class UnseenFit:
+    """A posterior's prediction of a record it was not fitted to.
+
+    ``time``, ``measured`` (through the chain), ``mean`` and ``sd`` (predictive: parameter
+    spread and the likelihood's sigma) over the compared samples.
+    """
+
+    data: str  # "validation" (a separate record) or "holdout" (the recording's tail)
+    time: np.ndarray
+    measured: np.ndarray
+    mean: np.ndarray
+    sd: np.ndarray
+
+    @property
+    def nrmse(self) -> float:
+        return nrmse(self.measured, self.mean)
+
+    @property
+    def outside_3sigma(self) -> float:
+        return outside_fraction(self.measured, self.mean, self.sd, 3.0)
+
+    @property
+    def coverage_3sigma(self) -> float:
+        return 1.0 - self.outside_3sigma
+
+    def to_dict(self) -> dict:
+        return {"data": self.data, "seconds": float(self.time[-1] - self.time[0]),
+                "nrmse": self.nrmse, "coverage_3sigma": self.coverage_3sigma,
+                "outside_3sigma": self.outside_3sigma}
+
+
+def unseen_fit(problem: ChainProblem, samples: np.ndarray, base_acc: np.ndarray,
+               rel_acc: np.ndarray, time: np.ndarray, section: tuple[int, int], data: str,
+               count: int = 100, seed: int = 0) -> UnseenFit:
+    """Posterior predictive of ``problem``'s structure for a record, over ``section``."""
+    theta = thin(samples, count, seed)
+    record = ChainProblem(problem.structure, base_acc, rel_acc, problem.dt, dict(problem.known),
+                          (section[0], section[1]), temper=problem.temper,
+                          lowpass_hz=problem.lowpass_hz, filter_order=problem.filter_order)
+    pred, ok = record.predicted(theta)
+    if not ok.any():
+        raise RuntimeError(f"no posterior sample of {problem.structure.name} can be simulated")
+    a, b = section
+    resp = pred[ok, a:b]
+    sigma = theta[ok, -1]
+    sd = np.sqrt(resp.var(axis=0, ddof=1) + np.mean(sigma**2)) if len(resp) > 1 else \
+        np.full(b - a, np.sqrt(np.mean(sigma**2)))
+    return UnseenFit(data, time[a:b], record.observed, resp.mean(axis=0), sd)
+
+
+# --------------------------------------------------------------------------- diagnosis.json
+
+
+def _locations(det) -> dict:
+    w, ws = det.windows, det.window_stats
+    w_thr = ws.threshold()
+    w_exp = w.expected_share()
+    w_share = np.exp(ws.observed)
+    w_p = ws.pointwise_p()
+    windows = [{"start": a, "stop": b, "energy_share": float(sh), "expected_share": float(ex),
+                "ratio": float(sh / ex), "z": float(z), "p_pointwise": float(p),
+                "flagged": bool(z >= w_thr and sh > ex)}
+               for (a, b), sh, ex, z, p in zip(w.bounds_s, w_share, w_exp, ws.z, w_p)]
+    rg, rs = det.regions, det.region_stats
+    r_thr = rs.threshold()
+    r_time = rg.time_share()
+    r_share = np.exp(rs.observed)
+    regions = [{"region": name, "description": rg.descriptions[name],
+                "time_share": float(ts), "energy_share": float(sh), "ratio": float(sh / ts),
+                "z": float(z), "p_pointwise": float(p), "flagged": bool(z >= r_thr and sh > ts)}
+               for name, ts, sh, z, p in zip(rg.names, r_time, r_share, rs.z, rs.pointwise_p())]
+    b, bs = det.bands, det.band_explained_stats
+    b_thr = bs.threshold()
+    total = det.band_energy.sum()
+    flat = b.flat_share()
+    bands = [{"low": lo, "high": hi, "energy_share": float(e / total),
+              "white_noise_share": float(fl), "explained_share": float(x / total),
+              "z": float(z), "flagged": bool(z >= b_thr)}
+             for (lo, hi), e, fl, x, z in zip(b.bounds_hz, det.band_energy, flat,
+                                              det.band_explained, bs.z)]
+    return {"time_windows_s": windows, "state_regions": regions, "frequency_bands_hz": bands,
+            "flag_rule": "z above the 95 % quantile of the family's largest z over stationary "
+                         "noise replicates, with more energy than expected"}
+
+
+def _detection(det) -> dict:
+    return {"p_value": det.p_value, "alpha": det.alpha, "significant": det.significant,
+            "test": "score tests of the candidates' signatures (library family); windows and "
+                    "regions are locations, reported with their own calibrated p-values",
+            "families": {f: {"statistic": float(det.family_statistic[f]), "p_value": float(p)}
+                         for f, p in det.family_p.items()},
+            "band_hz": [det.frame.f_low, det.frame.f_high], "sigma": det.sigma,
+            "prior_conflict": det.conflict,
+            "prior_conflicts": [c.to_dict() for c in det.conflicts]}
+
+
+def _equivalent(terms: tuple[str, ...]) -> str | None:
+    from harvester.structures import STRUCTURES
+    for name, t in STRUCTURES.items():
+        if set(t) == set(terms):
+            return name
+    return None
+
+
+def _fit_entry(structure, log_ev, source, unseen) -> dict:
+    out = {"structure": structure.name, "terms": list(structure.terms),
+           "equivalent_to": _equivalent(structure.terms), "log_evidence": log_ev,
+           "log_evidence_source": source}
+    if unseen is not None:
+        out.update({"nrmse": unseen.nrmse, "coverage_3sigma": unseen.coverage_3sigma,
+                    "outside_3sigma": unseen.outside_3sigma, "unseen_data": unseen.data,
+                    "unseen_seconds": float(unseen.time[-1] - unseen.time[0])})
+    else:
+        out.update({"nrmse": None, "coverage_3sigma": None, "outside_3sigma": None,
+                    "unseen_data": None})
+    return out
+
+
+def diagnosis_dict(d) -> dict:
+    """The JSON document of a :class:`~harvester.diagnosis.run.Diagnosis`."""
+    first = d.rounds[0]
+    candidates = []
+    for i, rnd in enumerate(d.rounds):
+        for res in rnd.confirmed:
+            entry = res.to_dict()
+            entry["round"] = i + 1
+            entry["reference"] = rnd.structure
+            entry["delta_log_evidence_vs_baseline"] = (res.fit.log_evidence
+                                                        - d.baseline_log_evidence)
+            candidates.append(entry)
+    improved_ev = d.improved_fit.log_evidence if d.improved_fit else d.baseline_log_evidence
+    fit = {"baseline": _fit_entry(d.baseline, d.baseline_log_evidence,
+                                  d.baseline_evidence_source, d.unseen_before),
+           "improved": _fit_entry(d.improved, improved_ev,
+                                  "diagnosis" if d.improved_fit else d.baseline_evidence_source,
+                                  d.unseen_after),
+           "log_evidence_gain": improved_ev - d.baseline_log_evidence,
+           "likelihood": "eq. (10) on z'' through the measurement chain's low-pass, tempered "
+                         "by lambda (effective share of independent samples)"}
+    if d.improved_fit is not None:
+        from harvester.physics import term
+        added = [p for t in d.improved.terms if t not in d.baseline.terms
+                 for p in term(t).parameter_names]
+        summ = d.improved_fit.summary()
+        fit["added_parameters"] = {n: summ[n] for n in added if n in summ}
+    s = d.settings
+    return {
+        "verdict": d.verdict,
+        "missing": d.missing,
+        "indistinguishable": d.indistinguishable,
+        "unexplained_mismatch": d.unexplained,
+        "baseline": d.baseline.name,
+        "improved": d.improved.name,
+        "candidates": candidates,
+        "locations": _locations(first.detection),
+        "fit": fit,
+        "detection": _detection(first.detection),
+        "ranking": [r.to_dict() for r in first.ranked],
+        "rounds": [{"structure": rnd.structure, "p_value": rnd.detection.p_value,
+                    "significant": rnd.detection.significant,
+                    "prior_conflict": rnd.detection.conflict,
+                    "sampled": [r.effect for r in rnd.confirmed],
+                    "accepted": rnd.accepted.effect if rnd.accepted else None}
+                   for rnd in d.rounds],
+        "measurement_chain": {"lowpass_hz": d.lowpass_hz, "filter_order": s.filter_order,
+                              "tempering_lambda": d.temper},
+        "analysis_window_s": list(d.window_s),
+        "tmcmc_window_s": list(d.fit_window_s),
+        "priors": {k: {"mean": v.mean, "sd": v.sd, "lower": v.lower, "unit": v.unit}
+                   for k, v in d.priors.items()},
+        "settings": {k: (list(v) if isinstance(v, tuple) else v)
+                     for k, v in s.__dict__.items()},
+        "runtime_s": d.seconds,
+        "notes": d.notes,
+        "figures": list(getattr(d, "figure_files", [])),
+    }
