@@ -43,6 +43,12 @@ from harvester.tmcmc import log_evidence
 log = logging.getLogger("harvester.diagnosis")
 
 
+#: A chain whose log evidence is this far below the best one missed the posterior's mode.
+MISSED_MODE_NATS = 5.0
+#: Smallest Monte Carlo standard error assumed for a pooled log evidence (nats).
+MIN_SE = 0.5
+
+
 @dataclass(frozen=True)
 class ConfirmSettings:
     """TMCMC and acceptance settings."""
@@ -52,7 +58,7 @@ class ConfirmSettings:
     seed: int = 0
     proposal_scale: float = 0.2
     target_cov: float = 1.0
-    mcmc_steps: int = 2
+    mcmc_steps: int = 3
     alpha: float = 0.05
     mc_sigmas: float = 2.0
     indistinguishable_nats: float = 2.0
@@ -88,8 +94,20 @@ class ModelFit:
 
     @property
     def log_evidence_se(self) -> float:
+        """Monte Carlo standard error of the pooled log evidence, from the chains that found
+        the posterior's main mode (within MISSED_MODE_NATS of the best chain); a chain far
+        below missed it, which lowers the pooled value by at most log(chains), and is counted
+        in ``missed_chains`` rather than as scatter."""
         c = self.log_evidence_chains
-        return float(np.std(c, ddof=1) / np.sqrt(len(c))) if len(c) > 1 else 0.0
+        near = c[c >= c.max() - MISSED_MODE_NATS]
+        if len(near) > 1:
+            return float(max(np.std(near, ddof=1) / np.sqrt(len(near)), MIN_SE))
+        return float(MIN_SE if len(c) > 1 else 0.0)
+
+    @property
+    def missed_chains(self) -> int:
+        c = self.log_evidence_chains
+        return int(np.sum(c < c.max() - MISSED_MODE_NATS))
 
     def summary(self) -> dict[str, dict[str, float]]:
         return {n: {"mean": float(self.samples[:, j].mean()),
@@ -115,6 +133,7 @@ class CandidateResult:
         return {"effect": self.effect, "structure": self.fit.structure.name,
                 "log_evidence": self.fit.log_evidence,
                 "log_evidence_chains": [float(x) for x in self.fit.log_evidence_chains],
+                "chains_missing_the_mode": self.fit.missed_chains,
                 "delta_log_evidence": self.delta_log_evidence,
                 "delta_log_evidence_se": self.delta_se, "threshold": self.threshold,
                 "accepted": self.accepted,
