@@ -19,6 +19,7 @@ include: "workflow/rules/initial.smk"
 include: "workflow/rules/identify.smk"
 include: "workflow/rules/validate.smk"
 include: "workflow/rules/summary.smk"
+include: "workflow/rules/diagnose.smk"
 include: "workflow/rules/detection.smk"
 include: "workflow/rules/emps.smk"
 

@@ -24,6 +24,7 @@ def small_config() -> dict:
     cfg["preprocess"]["training_samples"] = 1000
     cfg["tmcmc"].update(particles=200, chains=2, mcmc_steps=1)
     cfg["predictive"].update(samples=40, short_window_s=[2.0, 6.0])
+    cfg["diagnosis"].update(particles=100, chains=1, rounds=1, top=2, bootstrap=60)
     return cfg
 
 

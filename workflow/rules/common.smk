@@ -41,4 +41,5 @@ def all_outputs():
         "results/figures/fig09_tanh_unseen_section.png",
         "results/figures/fig10_tanh_unseen_full.png",
         "results/tables/headline.csv",
+        *[f"results/diagnosis/{m}/diagnosis.json" for m in MODELS],
     ]

@@ -3,6 +3,7 @@ and a baseline model, name it from the physics library, confirm it by evidence, 
 fit improve.
 
 Entry points: :func:`diagnose` (one recording), :func:`diagnose_study` (the study's rule),
+:func:`quick_detect` (detection and location only, MAP baseline, seconds),
 :class:`DiagnosisSettings` (``DiagnosisSettings.fast()`` for grids). Modules, in the order the
 diagnosis runs: ``baseline`` (likelihood through the measurement chain, MAP, sensitivities),
 ``spectral`` (frame, noise spectrum, replicates), ``signatures`` (candidate effects' output
@@ -12,7 +13,7 @@ state regions, frequency bands), ``rank``, ``confirm`` (TMCMC, evidence), ``repo
 """
 
 from harvester.diagnosis.run import (Diagnosis, DiagnosisSettings, check_recording, diagnose,
-                                     diagnose_study, write)
+                                     diagnose_study, quick_detect, write)
 
 __all__ = ["Diagnosis", "DiagnosisSettings", "check_recording", "diagnose", "diagnose_study",
-           "write"]
+           "quick_detect", "write"]

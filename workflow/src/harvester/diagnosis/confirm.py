@@ -51,12 +51,18 @@ MIN_SE = 0.5
 
 @dataclass(frozen=True)
 class ConfirmSettings:
-    """TMCMC and acceptance settings."""
+    """TMCMC and acceptance settings.
+
+    proposal_scale 0.8 (not Ching & Chen's 0.2): with 0.2 the Metropolis moves accept 85 %
+    and barely move, and the log evidence of the tanh model scatters by +-6 nats between
+    chains; with 0.8 they accept about 30 % and the chains agree within 0.5 nat (150 particles,
+    3 moves per stage; measured on a 10 s recording with a concealed end stop).
+    """
 
     particles: int = 300
     chains: int = 2
     seed: int = 0
-    proposal_scale: float = 0.2
+    proposal_scale: float = 0.8
     target_cov: float = 1.0
     mcmc_steps: int = 3
     alpha: float = 0.05

@@ -39,8 +39,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from harvester.diagnosis.baseline import BaselineState
-from harvester.diagnosis.locate import (FrequencyBands, Standardised, StateRegions,
-                                        TimeWindows, standardise)
+from harvester.diagnosis.locate import (FrequencyBands, MeasuredStandstill, Standardised,
+                                        StateRegions, TimeWindows, standardise)
 from harvester.diagnosis.signatures import Signature, motion_scale, signatures
 from harvester.diagnosis.spectral import (Frame, Metric, Projector, level_envelope,
                                           noise_replicates, removed_input_psd)
@@ -133,6 +133,7 @@ class Detection:
     window_stats: Standardised = field(repr=False)
     regions: StateRegions = field(repr=False)
     region_stats: Standardised = field(repr=False)
+    region_gain: Standardised = field(repr=False)  # observed = measured / model amplitude
     bands: FrequencyBands = field(repr=False)
     band_energy: np.ndarray = field(repr=False)  # residual energy per band
     band_explained: np.ndarray = field(repr=False)  # energy explained by the signatures
@@ -352,10 +353,37 @@ def detect(state: BaselineState, window: tuple[int, int], priors: Mapping[str, P
     w_stats = standardise(windows.statistic(series), windows.statistic(series_rep))
     regions = StateRegions(frame, state.rel_disp, state.rel_vel, state.rel_acc,
                            problem.base_acc)
-    r_stats = standardise(regions.statistic(series), regions.statistic(series_rep))
+    standstill = MeasuredStandstill(frame, state.rel_acc)
+    # the regions' statistics are log(energy share); the standstill's is log(share / time
+    # share) (its mask moves with the data), put on the same footing for the gate below
+    obs = np.append(regions.statistic(series), standstill.statistic(series))
+    rep = np.column_stack([regions.statistic(series_rep), standstill.statistic(series_rep)])
+    r_stats = standardise(obs, rep)
+    regions.add(standstill, float(np.mean(standstill.mask(series))))
+    # amplitude ratio measured / model in each region: 1 + <r, m> / <m, m> (0: the data do
+    # not move where the model does, as when the real device sticks)
+    model_band = frame.band_limited(frame.dft(state.rel_acc))
+
+    def gains(res: np.ndarray) -> np.ndarray:
+        masks = np.vstack([regions.matrix, standstill.mask(res)[None, :]]) if res.ndim == 1 \
+            else None
+        if masks is not None:
+            return 1.0 + (masks @ (res * model_band)) / np.maximum(masks @ model_band**2, 1e-300)
+        fixed = 1.0 + (res * model_band) @ regions.matrix.T / np.maximum(
+            regions.matrix @ model_band**2, 1e-300)
+        m = standstill.mask(res)
+        still = 1.0 + np.sum(m * res * model_band, axis=1) / np.maximum(
+            np.sum(m * model_band**2, axis=1), 1e-300)
+        return np.column_stack([fixed, still])
+
+    g_obs, g_rep = gains(series), gains(series_rep)
+    gain_stats = standardise(-np.abs(np.log(np.maximum(g_obs, 1e-3))),
+                             -np.abs(np.log(np.maximum(g_rep, 1e-3))))
+    gain_stats = Standardised(g_obs, -gain_stats.z, -gain_stats.z_replicates, g_rep)
     # a window or region enters the verdict only if it also holds a gross excess of energy
     w_gate = np.log(settings.gross_window_ratio * windows.expected_share())
     r_gate = np.log(settings.gross_region_ratio * regions.time_share())
+    r_gate[-1] = np.log(settings.gross_region_ratio)  # the standstill's statistic is a ratio
     fam_obs["windows"], fam_rep["windows"] = gated_max(w_stats, w_gate)
     fam_obs["regions"], fam_rep["regions"] = gated_max(r_stats, r_gate)
 
@@ -388,7 +416,8 @@ def detect(state: BaselineState, window: tuple[int, int], priors: Mapping[str, P
         family_statistic=fam_obs, signatures=sigs, z=z, absorbed=absorbed, gram=gram,
         signature_dft=Gp, metric=metric,
         candidates=cand_scores, conflicts=conflicts, windows=windows, window_stats=w_stats,
-        regions=regions, region_stats=r_stats, bands=bands, band_energy=band_energy,
+        regions=regions, region_stats=r_stats, region_gain=gain_stats, bands=bands,
+        band_energy=band_energy,
         band_explained=band_expl, band_explained_stats=b_stats, spectrum=spectrum,
         residual_dft=resid, residual_band=series, explained_band=frame.band_limited(explained),
         sigma=sigma)

@@ -60,7 +60,7 @@ def state_regions(diag, path: Path) -> Path:
     det, st = rnd.detection, rnd.state
     rg, rs = det.regions, det.region_stats
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.2))
-    ratio = np.exp(rs.observed) / rg.time_share()
+    ratio = rg.energy_share(rs.observed) / rg.time_share()
     ok = (rs.z >= rs.threshold()) & (ratio > 1)
     y = np.arange(len(rg.names))
     axes[0].barh(y, ratio, color=np.where(ok, "tab:red", "0.55"))

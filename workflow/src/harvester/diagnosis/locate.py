@@ -139,12 +139,28 @@ class StateRegions:
         self.matrix = np.array([self.masks[k] for k in self.names], dtype=float)  # (regions, n)
         self.weight = frame.time_weight
 
+        self.extra_time_share: list[float] = []
+
     def statistic(self, series: np.ndarray) -> np.ndarray:
         e = series**2
         return _log_share(e @ self.matrix.T, e.sum(axis=-1))
 
+    def add(self, region, time_share: float) -> None:
+        """Append a data-dependent region (its statistic is log(share / time share))."""
+        self.names.append(region.name)
+        self.descriptions[region.name] = region.description
+        self.extra_time_share.append(time_share)
+
     def time_share(self) -> np.ndarray:
-        return (self.matrix @ self.weight) / self.weight.sum()
+        fixed = (self.matrix @ self.weight) / self.weight.sum()
+        return np.append(fixed, self.extra_time_share)
+
+    def energy_share(self, statistic: np.ndarray) -> np.ndarray:
+        """Energy shares from the statistics (log share; log ratio for added regions)."""
+        k = self.matrix.shape[0]
+        out = np.exp(statistic).copy()
+        out[k:] *= np.array(self.extra_time_share)
+        return out
 
 
 class FrequencyBands:
@@ -169,3 +185,41 @@ class FrequencyBands:
     def flat_share(self) -> np.ndarray:
         e = np.array([self.power_weight[i].sum() for i in self.index])
         return e / e.sum()
+
+
+#: Half-width (s) of the running maximum that defines a standstill of the measured motion.
+STANDSTILL_HALF_S = 0.02
+
+
+class MeasuredStandstill:
+    """Where the MEASURED relative acceleration stays near zero for a while: the mass moving
+    with the base (friction sticking), whatever the model does there.
+
+    Samples whose running maximum of |z''| over +-STANDSTILL_HALF_S is below that maximum's
+    ``quantile``; the mask depends on the data, so it is recomputed for each replicate
+    (model + replicate residual), which calibrates the selection.
+    """
+
+    name = "measured_standstill"
+    description = ("measured |z''| near zero for 40 ms or more (the mass moving with the "
+                   "base: sticking)")
+
+    def __init__(self, frame: Frame, model: np.ndarray, quantile: float = REGION_QUANTILE
+                 ) -> None:
+        self.model = model[frame.start:frame.stop] * frame.taper
+        self.width = max(3, int(round(2 * STANDSTILL_HALF_S * frame.fs)) | 1)
+        self.quantile = quantile
+        self.weight = frame.time_weight
+
+    def mask(self, series: np.ndarray) -> np.ndarray:
+        from scipy import ndimage
+        peak = ndimage.maximum_filter1d(np.abs(self.model + series), self.width, axis=-1)
+        return peak <= np.quantile(peak, self.quantile, axis=-1, keepdims=True)
+
+    def statistic(self, series: np.ndarray) -> np.ndarray:
+        """log(energy share / time share) in the standstill mask, (...,)."""
+        m = self.mask(series)
+        e = series**2
+        share = np.sum(e * m, axis=-1) / np.maximum(np.sum(e, axis=-1), 1e-300)
+        time = np.sum(self.weight * m, axis=-1) / self.weight.sum()
+        return np.log(np.maximum(share, 1e-300) / np.maximum(time, 1e-300))

@@ -77,11 +77,16 @@ def _locations(det) -> dict:
     rg, rs = det.regions, det.region_stats
     r_thr = rs.threshold()
     r_time = rg.time_share()
-    r_share = np.exp(rs.observed)
+    r_share = rg.energy_share(rs.observed)
+    gs = det.region_gain
+    g_thr = gs.threshold()
     regions = [{"region": name, "description": rg.descriptions[name],
                 "time_share": float(ts), "energy_share": float(sh), "ratio": float(sh / ts),
-                "z": float(z), "p_pointwise": float(p), "flagged": bool(z >= r_thr and sh > ts)}
-               for name, ts, sh, z, p in zip(rg.names, r_time, r_share, rs.z, rs.pointwise_p())]
+                "z": float(z), "p_pointwise": float(p), "flagged": bool(z >= r_thr and sh > ts),
+                "amplitude_ratio": float(g), "amplitude_z": float(gz),
+                "amplitude_flagged": bool(gz >= g_thr and abs(np.log(max(g, 1e-3))) > np.log(1.25))}
+               for name, ts, sh, z, p, g, gz in zip(rg.names, r_time, r_share, rs.z,
+                                                    rs.pointwise_p(), gs.observed, gs.z)]
     b, bs = det.bands, det.band_explained_stats
     b_thr = bs.threshold()
     total = det.band_energy.sum()
@@ -93,7 +98,10 @@ def _locations(det) -> dict:
                                               det.band_explained, bs.z)]
     return {"time_windows_s": windows, "state_regions": regions, "frequency_bands_hz": bands,
             "flag_rule": "z above the 95 % quantile of the family's largest z over stationary "
-                         "noise replicates, with more energy than expected"}
+                         "noise replicates, with more energy than expected; amplitude_ratio is "
+                         "measured / model amplitude in the region (1 + <r, m> / <m, m>, 0 when "
+                         "the data stand still where the model moves), amplitude_flagged when "
+                         "its departure from 1 is significant in the same way and above 25 %"}
 
 
 def _detection(det) -> dict:

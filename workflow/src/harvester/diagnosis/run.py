@@ -370,6 +370,32 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
     return diag
 
 
+def quick_detect(recording: pd.DataFrame, baseline: str | ModelStructure,
+                 known: Mapping[str, float], priors: Mapping[str, PriorSpec] | None = None,
+                 settings: DiagnosisSettings = DiagnosisSettings(), temper: float | None = None
+                 ) -> tuple[Detection, BaselineState]:
+    """Detection and location only, with the baseline's MAP and Laplace posterior instead of
+    TMCMC (seconds, not minutes): the first step of :func:`diagnose` for screening many
+    recordings. The whole recording after the lead-in is analysed (nothing held out)."""
+    rec, dt = check_recording(recording, "<recording>", settings.lead_in_s)
+    base = named_structure(baseline) if isinstance(baseline, str) else baseline
+    fs = 1.0 / dt
+    lead = int(round(settings.lead_in_s * fs))
+    lowpass = settings.lowpass_hz or filter_cutoff(rec["rel_acc"].to_numpy(), fs)
+    raw = make_problem(rec, base, known, window=(lead, len(rec)))
+    if temper is None:
+        mp = fit_map(chain_problem(raw, 1.0, lowpass, settings.filter_order), priors or {},
+                     seed=settings.seed)
+        temper = estimate_temper(mp.residual, raw.window, fs, 0.9 * (lowpass or 0.5 * fs))
+    problem = chain_problem(raw, temper, lowpass, settings.filter_order)
+    mp = fit_map(problem, priors or {}, seed=settings.seed)
+    specs = {**default_priors(base, float(mp.theta[-1])), **(priors or {})}
+    state = baseline_state(problem, mp.samples(200, settings.seed))
+    det = detect(state, problem.window, specs, candidate_terms(base.terms, settings.candidates),
+                 settings.detection(), time=rec["time"].to_numpy())
+    return det, state
+
+
 def write(diag: Diagnosis, out_dir: str | Path) -> Path:
     """diagnosis.json and the figures in ``out_dir``; returns the JSON's path."""
     from harvester.fileio import write_json

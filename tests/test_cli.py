@@ -1,0 +1,118 @@
+"""``harvester diagnose``: bad input gets a clear error, a short recording runs end to end."""
+
+from __future__ import annotations
+
+import json
+import logging
+
+import numpy as np
+import pytest
+
+from harvester.cli import main
+from harvester.daq import write_recording
+from harvester.diagnosis.synthetic import TABLE1_KNOWN, TANH_TABLE5, measured_recording
+
+pytestmark = pytest.mark.filterwarnings("ignore::UserWarning", "ignore::RuntimeWarning")
+
+
+@pytest.fixture(autouse=True)
+def _restore_logging():
+    yield
+    logging.getLogger("harvester").handlers.clear()
+
+
+@pytest.fixture(scope="module")
+def recording(tmp_path_factory):
+    """8 s of the tanh model (Table 5) through the study's measurement chain."""
+    df, _ = measured_recording(("tanh_friction",), {**TABLE1_KNOWN, **TANH_TABLE5}, 8.0, 21)
+    path = tmp_path_factory.mktemp("rec") / "rec.csv"
+    write_recording(df, path)
+    return path, df
+
+
+def _write_csv(path, text):
+    path.write_text(text)
+    return path
+
+
+def _run(args, capsys):
+    code = main(args)
+    return code, capsys.readouterr().err
+
+
+@pytest.mark.parametrize("mutate, message", [
+    (lambda df: df.drop(columns="base_acc"), "missing column"),
+    (lambda df: df.assign(rel_acc=np.where(np.arange(len(df)) == 40, np.nan, df.rel_acc)),
+     "NaN"),
+    (lambda df: df.assign(time=df.time + np.where(np.arange(len(df)) > 100, 0.001, 0.0)),
+     "non-uniform time"),
+    (lambda df: df.iloc[:700], "too short"),
+])
+def test_bad_input_gets_a_clear_error(recording, tmp_path, capsys, mutate, message):
+    _, df = recording
+    bad = mutate(df.copy())
+    path = tmp_path / "bad.csv"
+    bad.to_csv(path, index=False, na_rep="nan")
+    code, err = _run(["diagnose", str(path), "--baseline", "tanh", "--out",
+                      str(tmp_path / "out"), "--log", str(tmp_path / "log.txt")], capsys)
+    assert code == 2
+    assert message in err and "bad.csv" in err
+    assert not (tmp_path / "out" / "diagnosis.json").exists()
+
+
+def test_bad_metadata_and_options_get_clear_errors(recording, tmp_path, capsys):
+    _, df = recording
+    path = tmp_path / "r.csv"
+    df.to_csv(path, index=False)
+    (tmp_path / "r.yaml").write_text("M: 12.8\nm: -8\n")
+    code, err = _run(["diagnose", str(path), "--baseline", "linear", "--out",
+                      str(tmp_path / "o"), "--log", str(tmp_path / "l.txt")], capsys)
+    assert code == 2 and "'m' must be a positive number" in err
+    (tmp_path / "r.yaml").write_text("M: 12.8\nstiffness: 250\n")
+    code, err = _run(["diagnose", str(path), "--baseline", "linear", "--out",
+                      str(tmp_path / "o"), "--log", str(tmp_path / "l.txt")], capsys)
+    assert code == 2 and "unknown key" in err
+    (tmp_path / "r.yaml").unlink()
+    code, err = _run(["diagnose", str(path), "--baseline", "linear", "--out",
+                      str(tmp_path / "o"), "--lowpass", "500", "--log",
+                      str(tmp_path / "l.txt")], capsys)
+    assert code == 2 and "--lowpass" in err
+    with pytest.raises(SystemExit):
+        main(["diagnose", str(path), "--baseline", "quadratic", "--out", str(tmp_path)])
+
+
+def test_cli_end_to_end_writes_diagnosis_json(recording, tmp_path, capsys):
+    path, _ = recording
+    (path.parent / "rec.yaml").write_text("M: 12.8\nm: 8.0\nk: 250.0\n")
+    out = tmp_path / "diag"
+    code = main(["diagnose", str(path), "--baseline", "linear", "--out", str(out), "--fast",
+                 "--particles", "60", "--top", "1", "--seed", "3",
+                 "--log", str(tmp_path / "progress.log")])
+    assert code == 0
+    assert "->" in capsys.readouterr().out
+    d = json.loads((out / "diagnosis.json").read_text())
+    assert d["verdict"] in ("adequate", "missing_physics")
+    assert isinstance(d["missing"], list) and all(isinstance(m, str) for m in d["missing"])
+    # a linear model of a friction device is not adequate, and friction is what it misses
+    assert d["verdict"] == "missing_physics"
+    for c in d["candidates"]:
+        assert isinstance(c["effect"], str)
+        for key in ("log_evidence", "delta_log_evidence"):
+            assert isinstance(c[key], float)
+        for stats in c["parameters"].values():
+            assert isinstance(stats["mean"], float) and isinstance(stats["sd"], float)
+    loc = d["locations"]
+    assert loc["time_windows_s"] and loc["state_regions"] and loc["frequency_bands_hz"]
+    for w in loc["time_windows_s"]:
+        assert w["stop"] > w["start"] and 0 <= w["energy_share"] <= 1
+    for r in loc["state_regions"]:
+        assert isinstance(r["region"], str) and 0 <= r["energy_share"] <= 1
+    for b in loc["frequency_bands_hz"]:
+        assert b["high"] > b["low"] >= 0
+    for which in ("baseline", "improved"):
+        entry = d["fit"][which]
+        assert isinstance(entry["log_evidence"], float)
+        assert isinstance(entry["nrmse"], float) and 0 <= entry["coverage_3sigma"] <= 1
+    for name in d["figures"]:
+        assert (out / name).stat().st_size > 1000
+    assert "verdict" in (tmp_path / "progress.log").read_text()

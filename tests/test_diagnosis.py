@@ -1,0 +1,135 @@
+"""Diagnosis of missing physics: detection calibrated on effect-free recordings, concealed
+effects found and named, locations, ranking, the measurement chain and the tempering.
+
+Fast versions: MAP baselines (no TMCMC), 10-20 s recordings, 200 noise replicates. The
+statistical checks over many seeds are in test_diagnosis_calibration.py (slow).
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pytest
+
+from harvester.diagnosis import DiagnosisSettings, quick_detect
+from harvester.diagnosis.baseline import (ChainProblem, chain_problem,
+                                          integrated_autocorrelation_time)
+from harvester.diagnosis.detect import estimate_temper
+from harvester.diagnosis.rank import rank
+from harvester.diagnosis.spectral import filter_cutoff
+from harvester.diagnosis.synthetic import (TABLE1_KNOWN, TANH_TABLE5, concealed_recording,
+                                           measured_recording)
+from harvester.identify import make_problem
+from harvester.priors import PriorSpec
+from harvester.signals import lowpass
+
+pytestmark = pytest.mark.filterwarnings("ignore::UserWarning", "ignore::RuntimeWarning")
+
+FS = 256.0
+PRIORS = {"c_m": PriorSpec("c_m", 170.0, 50.0, "N s/m"), "F_c": PriorSpec("F_c", 8.4, 5.0, "N"),
+          "beta": PriorSpec("beta", 100.0, 100.0, "s/m"),
+          "sigma": PriorSpec("sigma", 0.07, 0.03, "m/s^2")}
+
+
+@pytest.fixture(autouse=True)
+def _quiet():
+    logging.getLogger("harvester").setLevel(logging.WARNING)
+    yield
+
+
+def run_detection(df, baseline="tanh", seed=0):
+    """MAP baseline (Laplace posterior) after a 1 s lead-in, then the calibrated detection."""
+    settings = DiagnosisSettings(bootstrap=200, artifact_components=30, seed=seed)
+    return quick_detect(df, baseline, TABLE1_KNOWN, PRIORS, settings)
+
+
+# --------------------------------------------------------------------------- building blocks
+
+
+def test_filter_cutoff_finds_a_preprocessing_lowpass_and_nothing_else():
+    y = np.random.default_rng(0).standard_normal(20 * 256)
+    assert filter_cutoff(y, FS) is None
+    for cut in (12.0, 20.0, 40.0):
+        found = filter_cutoff(lowpass(y, FS, cut, 8), FS)
+        assert found is not None and 0.85 * cut < found <= 1.02 * cut
+
+
+def test_chain_problem_without_chain_is_eq10_and_tempering_scales_it():
+    df, _ = measured_recording(("tanh_friction",), {**TABLE1_KNOWN, **TANH_TABLE5}, 6.0, 1)
+    plain = make_problem(df, "tanh", TABLE1_KNOWN, window=(256, 1200))
+    theta = np.array([[109.5, 11.86, 88.35, 0.05], [150.0, 9.0, 60.0, 0.08]])
+    chained = chain_problem(plain, 1.0, None)
+    np.testing.assert_allclose(chained.loglike(theta), plain.loglike(theta), rtol=1e-10)
+    half = chain_problem(plain, 0.5, None)
+    np.testing.assert_allclose(half.loglike(theta), 0.5 * plain.loglike(theta), rtol=1e-10)
+    # through a 20 Hz chain the true parameters leave a residual at the noise level
+    filtered = chain_problem(plain, 1.0, 19.0)
+    assert isinstance(filtered, ChainProblem)
+    r = filtered.residuals(theta[:1])[0]
+    assert np.std(r) < 0.05
+
+
+def test_tempering_is_the_share_of_independent_samples_of_band_limited_noise():
+    rng = np.random.default_rng(3)
+    noise = lowpass(rng.standard_normal(30 * 256), FS, 20.0, 8)
+    lam = estimate_temper(noise, (256, 29 * 256), FS, 18.0)
+    assert lam == pytest.approx(2 * 20.0 / FS, rel=0.3)
+    white = rng.standard_normal(30 * 256)
+    # white noise: about 1 (a little less: the densest tenth of the band sets lambda)
+    assert 0.6 < estimate_temper(white, (256, 29 * 256), FS, 115.0) <= 1.0
+    # Sokal's integrated autocorrelation time is the other view of the same correlation
+    assert integrated_autocorrelation_time(white) == pytest.approx(1.0, abs=0.3)
+
+
+# --------------------------------------------------------------------------- detection
+
+
+@pytest.fixture(scope="module")
+def null_detections():
+    """Recordings of the baseline itself (tanh, Table 5), both sensors noisy, 20 Hz chain."""
+    out = []
+    for seed in range(4):
+        df, _ = measured_recording(("tanh_friction",), {**TABLE1_KNOWN, **TANH_TABLE5}, 12.0,
+                                   300 + seed)
+        out.append(run_detection(df, seed=seed)[0])
+    return out
+
+
+def test_no_false_alarm_on_effect_free_recordings(null_detections):
+    # calibrated at 5 %: four clean recordings should rarely flag; and never strongly
+    ps = np.array([d.p_value for d in null_detections])
+    assert np.sum(ps < 0.05) <= 1
+    assert np.all(ps > 0.005)
+    # the standardised scores of single-shape, signed effects are ~N(0, 1) under the null
+    z = np.array([d.z[c.index] for d in null_detections for c in d.candidates
+                  if d.signatures[c.index].signed])
+    assert abs(np.mean(z)) < 0.8 and 0.4 < np.std(z) < 1.6
+
+
+@pytest.mark.parametrize("effect", ["end_stop", "unmodelled_mode", "asymmetric_friction"])
+def test_concealed_effect_below_noise_is_detected_and_named(effect):
+    df, info = concealed_recording(effect, 0.5, 11, 16.0)
+    assert info["effect_rms"] < info["noise_rms"]
+    det, state = run_detection(df, seed=1)
+    assert det.significant, f"{effect}: p = {det.p_value}"
+    ranked = rank(det, state, PRIORS)
+    top = [r.effect for r in ranked[:2]]
+    family = {"end_stop": {"end_stop", "cubic_stiffness"}, "unmodelled_mode": {"unmodelled_mode"},
+              "asymmetric_friction": {"asymmetric_friction"}}[effect]
+    assert family & set(top), f"{effect}: ranked {top}"
+
+
+def test_linear_baseline_on_friction_data_names_friction_and_conflicts_with_prior():
+    df, _ = measured_recording(("tanh_friction",), {**TABLE1_KNOWN, **TANH_TABLE5}, 12.0, 5)
+    det, state = run_detection(df, baseline="linear")
+    assert det.significant and det.p_value < 0.01
+    # damping driven far above the prior by the missing friction
+    assert any(c.conflict and c.parameter == "c_m" for c in det.conflicts)
+    ranked = rank(det, state, PRIORS)
+    assert ranked[0].effect in {"tanh_friction", "coulomb_friction", "stribeck_friction",
+                                "hysteresis"}
+    # locations: every family reports shares that add up
+    shares = np.exp(det.window_stats.observed)
+    assert shares.sum() == pytest.approx(1.0, rel=1e-6)
+    assert det.band_energy.sum() > 0 and np.all(det.band_explained >= 0)
