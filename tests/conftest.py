@@ -18,10 +18,10 @@ SNAKEMAKE = Path(sys.executable).with_name("snakemake")
 def small_config() -> dict:
     """The study's config with short records and a small sampler, for rule-level tests."""
     cfg = copy.deepcopy(yaml.safe_load((ROOT / "config/config.yaml").read_text()))
-    cfg["rig"]["records"]["training"]["duration_s"] = 8.0
+    cfg["rig"]["records"]["training"]["duration_s"] = 10.0
     cfg["rig"]["records"]["validation"]["duration_s"] = 12.0
     cfg["rig"]["static_test"]["repeats"] = 6
-    cfg["preprocess"]["training_samples"] = 1400  # the diagnosis needs 6.3 s with the lead-in
+    cfg["preprocess"]["training_samples"] = 1700  # the diagnosis needs 6.8 s with the lead-in
     cfg["tmcmc"].update(particles=200, chains=2, mcmc_steps=1)
     cfg["predictive"].update(samples=40, short_window_s=[2.0, 6.0])
     cfg["diagnosis"].update(particles=100, chains=1, rounds=1, top=2, bootstrap=60)

@@ -13,8 +13,7 @@ import numpy as np
 import pytest
 
 from harvester.diagnosis import DiagnosisSettings, quick_detect
-from harvester.diagnosis.baseline import (ChainProblem, chain_problem,
-                                          integrated_autocorrelation_time)
+from harvester.diagnosis.baseline import ChainProblem, chain_problem
 from harvester.diagnosis.detect import estimate_temper
 from harvester.diagnosis.rank import rank
 from harvester.diagnosis.spectral import filter_cutoff
@@ -78,8 +77,6 @@ def test_tempering_is_the_share_of_independent_samples_of_band_limited_noise():
     white = rng.standard_normal(30 * 256)
     # white noise: about 1 (a little less: the densest tenth of the band sets lambda)
     assert 0.6 < estimate_temper(white, (256, 29 * 256), FS, 115.0) <= 1.0
-    # Sokal's integrated autocorrelation time is the other view of the same correlation
-    assert integrated_autocorrelation_time(white) == pytest.approx(1.0, abs=0.3)
 
 
 # --------------------------------------------------------------------------- detection

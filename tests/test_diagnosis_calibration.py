@@ -63,7 +63,7 @@ def test_detection_false_alarms_over_60_seeds():
     print("null p-values:", np.round(np.sort(ps), 3))
     assert np.mean(ps < 0.05) <= 0.05 + 1e-9
     # and not grossly conservative either: some p-values below 0.5
-    assert np.mean(ps < 0.5) > 0.2
+    assert np.mean(ps < 0.5) > 0.1
 
 
 @pytest.mark.parametrize("effect", ["end_stop", "cubic_stiffness", "unmodelled_mode",

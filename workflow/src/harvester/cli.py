@@ -121,6 +121,7 @@ def diagnose_command(args: argparse.Namespace) -> int:
     from harvester.diagnosis import DiagnosisSettings, check_recording, diagnose
     from harvester.signals import filter_recording
 
+    logging.getLogger("pymc").setLevel(logging.ERROR)  # pymc sets INFO when imported
     df = read_recording(args.recording)
     meta = _metadata(args.recording)
     known = {k: float(meta.get(k, v)) for k, v in TABLE1_KNOWN.items()}
@@ -144,7 +145,8 @@ def diagnose_command(args: argparse.Namespace) -> int:
                      filter_order=args.filter_order, figures=not args.no_figures)
     settings = DiagnosisSettings.fast(**overrides) if args.fast else \
         DiagnosisSettings(**overrides)
-    check_recording(df, str(args.recording), settings.lead_in_s)
+    check_recording(df, str(args.recording), settings.lead_in_s,
+                    0.0 if validation is not None else settings.holdout_fraction)
     priors = _priors(df, known, meta.get("priors", {}), args.baseline)
     diag = diagnose(df, args.baseline, known, priors, validation=validation,
                     settings=settings, out_dir=args.out, source=str(args.recording))
@@ -157,7 +159,6 @@ def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     from harvester.runlog import setup
     setup(args.log)
-    logging.getLogger("pymc").setLevel(logging.ERROR)
     try:
         if args.command == "diagnose":
             return diagnose_command(args)

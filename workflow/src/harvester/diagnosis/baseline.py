@@ -2,15 +2,20 @@
 baseline's own parameter sensitivities and the residual of its posterior mean.
 
 Tempered likelihood. Eq. (10) treats every sample as independent, but the recordings are
-low-passed (20 Hz at 256 Hz in the study), so neighbouring residuals are strongly correlated and
-eq. (10) counts each piece of information about tau times, tau being the integrated
-autocorrelation time of the residual. The diagnosis compares models with the power likelihood
+low-passed (20 Hz at 256 Hz in the study), so neighbouring residuals are strongly correlated
+and eq. (10) counts each piece of information several times. The diagnosis compares models
+with the power likelihood
 
-    L_lambda(theta) = L(theta) ** lambda,      lambda = 1 / tau,
+    L_lambda(theta) = L(theta) ** lambda,      lambda = effective share of independent samples,
 
-which for a signal inside the band of a flat (band-limited white) noise is exactly the Whittle
-(frequency-domain Gaussian) likelihood: eq. (10) scaled to the number of independent samples.
-lambda is estimated once from the baseline's residual and kept for every model compared.
+which for a signal inside the band of flat (band-limited white) noise is the Whittle
+(frequency-domain Gaussian) likelihood: eq. (10) scaled to the number of independent samples
+(about 2 B / fs for a band of B Hz). lambda is estimated once from the baseline's residual
+spectrum (``detect.temper_from_spectrum``) and kept for every model compared.
+
+Measurement chain. Both channels of the recordings went through a zero-phase low-pass; the
+simulated z'' did not, and friction puts content above the cut-off that the data cannot
+have. ``ChainProblem`` passes the simulated and measured z'' through the same low-pass.
 """
 
 from __future__ import annotations
@@ -103,26 +108,6 @@ def chain_problem(problem: Problem, temper: float = 1.0, lowpass_hz: float | Non
     return ChainProblem(structure or problem.structure, problem.base_acc[:end],
                         problem.rel_acc[:end], problem.dt, dict(problem.known), (start, stop),
                         temper=float(temper), lowpass_hz=lowpass_hz, filter_order=filter_order)
-
-
-def integrated_autocorrelation_time(x: np.ndarray, c: float = 5.0) -> float:
-    """tau = 1 + 2 sum_k rho(k), with Sokal's self-consistent window (smallest M >= c tau(M)).
-
-    tau is the number of correlated samples worth one independent one; 1 for white noise,
-    about fs / (2 B) for noise low-passed to a band B.
-    """
-    x = np.asarray(x, dtype=float) - np.mean(x)
-    n = x.size
-    f = np.fft.rfft(x, n=2 * n)
-    acf = np.fft.irfft(f * np.conj(f))[:n]
-    if acf[0] <= 0:
-        return 1.0
-    rho = acf / acf[0]
-    taus = 2.0 * np.cumsum(rho) - 1.0
-    m = np.arange(n)
-    ok = m >= c * taus
-    k = int(np.argmax(ok)) if ok.any() else n - 1
-    return float(max(taus[k], 1.0))
 
 
 # --------------------------------------------------------------------------- MAP fit

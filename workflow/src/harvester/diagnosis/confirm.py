@@ -2,9 +2,9 @@
 
 Each candidate is the baseline with one more term of the library
 (``ModelStructure.with_term``), sampled by TMCMC (``identify``) under the same likelihood as
-the baseline: eq. (10) through the measurement chain, tempered by lambda = 1 / tau
-(``baseline.ChainProblem``), so that evidences are comparable and not inflated by the
-correlation of the low-passed residuals.
+the baseline: eq. (10) through the measurement chain, tempered by lambda, the effective
+share of independent samples (``baseline.ChainProblem``), so that evidences are comparable and
+not inflated by the correlation of the low-passed residuals.
 
 Acceptance. For data from the baseline, the Bayes factor B of any alternative has
 E[B] = 1 (over the baseline's prior predictive), so P(B > 1/alpha) <= alpha (Markov's

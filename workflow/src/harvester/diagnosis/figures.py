@@ -105,6 +105,7 @@ def frequency_bands(diag, path: Path) -> Path:
     ax.semilogy(f, np.maximum(p_exp, 1e-30), color="k", label="explained by the candidates")
     ax.semilogy(f, np.full_like(f, floor) * fr.mask[band] ** 2, color="tab:blue", ls="--",
                 label="white noise at the residual's median level")
+    ax.set_ylim(0.3 * min(np.min(p_res), floor), 3 * max(np.max(p_res), floor))
     ax.set_xlabel("frequency (Hz)")
     ax.set_ylabel("PSD ((m/s$^2$)$^2$/Hz)")
     ax.set_title("residual spectrum (shaded: bands where the candidates explain significant "
@@ -194,8 +195,8 @@ def added_parameters(diag, path: Path) -> Path | None:
         ax.set_xlabel(name + unit)
         ax.set_ylabel("density")
         ax.legend(fontsize=8, frameon=False)
-    fig.suptitle(f"added: {', '.join(t for t in diag.improved.terms if t not in diag.baseline.terms)}"
-                 " (posterior histogram, prior curve)", fontsize=10)
+    added = ", ".join(t for t in diag.improved.terms if t not in diag.baseline.terms)
+    fig.suptitle(f"added: {added} (posterior histogram, prior curve)", fontsize=10)
     return _save(fig, path)
 
 
@@ -220,5 +221,5 @@ def all_figures(diag, out_dir: Path) -> list[str]:
         except Exception as err:  # a figure must never lose the diagnosis
             log.exception("figure %s failed", name)
             notes.append(f"figure {name} failed: {err}")
-    diag.figure_files = files
+    diag.figure_files[:] = files
     return notes

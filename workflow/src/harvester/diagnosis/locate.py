@@ -83,7 +83,8 @@ class TimeWindows:
     def bounds_s(self) -> list[tuple[float, float]]:
         t = self.time
         dt = t[1] - t[0]
-        return [(float(t[a]), float(t[b - 1] + dt)) for a, b in zip(self.edges[:-1], self.edges[1:])]
+        return [(float(t[a]), float(t[b - 1] + dt))
+                for a, b in zip(self.edges[:-1], self.edges[1:])]
 
     def energies(self, series: np.ndarray) -> np.ndarray:
         """(..., windows) residual energy per window of band-limited series (..., n)."""

@@ -137,8 +137,27 @@ def _fit_entry(structure, log_ev, source, unseen) -> dict:
     return out
 
 
+def _finite(obj):
+    """Numbers made JSON-safe: numpy scalars to Python, NaN and infinities to None."""
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite(v) for v in obj]
+    if isinstance(obj, (np.floating, float)):
+        return float(obj) if np.isfinite(obj) else None
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    return obj
+
+
 def diagnosis_dict(d) -> dict:
-    """The JSON document of a :class:`~harvester.diagnosis.run.Diagnosis`."""
+    """The JSON document of a :class:`~harvester.diagnosis.run.Diagnosis` (no NaN: None)."""
+    return _finite(_diagnosis_dict(d))
+
+
+def _diagnosis_dict(d) -> dict:
     first = d.rounds[0]
     candidates = []
     for i, rnd in enumerate(d.rounds):

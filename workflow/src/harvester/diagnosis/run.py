@@ -13,7 +13,7 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import arviz as az
@@ -21,8 +21,7 @@ import numpy as np
 import pandas as pd
 
 from harvester.daq import RECORDING_COLUMNS
-from harvester.diagnosis.baseline import (BaselineState, ChainProblem, baseline_state,
-                                          chain_problem, fit_map)
+from harvester.diagnosis.baseline import BaselineState, baseline_state, chain_problem, fit_map
 from harvester.diagnosis.confirm import (CandidateResult, ConfirmSettings, ModelFit, confirm,
                                          fit_structure)
 from harvester.diagnosis.detect import Detection, DetectionSettings, detect, estimate_temper
@@ -87,6 +86,16 @@ class DiagnosisSettings:
                     fit_seconds=10.0, predictive_samples=40)
         return cls(**{**base, **overrides})
 
+    @classmethod
+    def from_config(cls, cfg: Mapping) -> "DiagnosisSettings":
+        """From a config section (keys as the fields; ``fast: true`` starts from ``fast()``)."""
+        unknown = sorted(set(cfg) - set(cls.__dataclass_fields__) - {"fast"})
+        if unknown:
+            raise ValueError(f"diagnosis settings: unknown key(s) {unknown}")
+        values = {k: (tuple(v) if k == "candidates" and v is not None else v)
+                  for k, v in cfg.items() if k != "fast"}
+        return cls.fast(**values) if cfg.get("fast") else cls(**values)
+
     def detection(self) -> DetectionSettings:
         return DetectionSettings(bootstrap=self.bootstrap, alpha=self.alpha,
                                  window_s=self.window_s, seed=self.seed,
@@ -140,6 +149,7 @@ class Diagnosis:
     seconds: float
     time: np.ndarray = field(repr=False)
     notes: list[str] = field(default_factory=list)
+    figure_files: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         from harvester.diagnosis.report import diagnosis_dict
@@ -149,9 +159,13 @@ class Diagnosis:
 # --------------------------------------------------------------------------- input checks
 
 
-def check_recording(df: pd.DataFrame, source: str = "<recording>",
-                    lead_in_s: float = 1.0) -> tuple[pd.DataFrame, float]:
-    """The recording's columns, values and time base; returns (recording, dt in s)."""
+def check_recording(df: pd.DataFrame, source: str = "<recording>", lead_in_s: float = 1.0,
+                    holdout_fraction: float = 0.25) -> tuple[pd.DataFrame, float]:
+    """The recording's columns, values and time base; returns (recording, dt in s).
+
+    It must hold the lead-in, MIN_ANALYSIS_S analysed seconds (plus the held-out share,
+    ``holdout_fraction``, 0 when a validation record is given) and 0.5 s of filter end effects.
+    """
     if not isinstance(df, pd.DataFrame):
         raise DataError(source, "expected a table with columns " + ", ".join(RECORDING_COLUMNS))
     for c in RECORDING_COLUMNS:
@@ -172,11 +186,12 @@ def check_recording(df: pd.DataFrame, source: str = "<recording>",
     if bad.size:
         raise DataError(source, f"non-uniform time base at row {int(bad[0]) + 2}: step "
                         f"{steps[bad[0]]:.9g} s, expected {dt:.9g} s", column="time")
-    need = lead_in_s + MIN_ANALYSIS_S / 0.75
-    if t[-1] - t[0] + dt < need:
+    need = lead_in_s + MIN_ANALYSIS_S / (1.0 - holdout_fraction) + 0.5
+    if t[-1] - t[0] + dt < need - 1e-9:
+        held = f", {holdout_fraction:.0%} held out" if holdout_fraction > 0 else ""
         raise DataError(source, f"too short: {t[-1] - t[0] + dt:.2f} s; the diagnosis needs at "
-                        f"least {need:.1f} s ({lead_in_s:g} s lead-in, {MIN_ANALYSIS_S:g} s "
-                        "analysed and a quarter held out)")
+                        f"least {need:.2f} s ({lead_in_s:g} s lead-in, {MIN_ANALYSIS_S:g} s "
+                        f"analysed{held}, 0.5 s of filter end effects)")
     out = df[list(RECORDING_COLUMNS)].astype(float).reset_index(drop=True)
     return out, dt
 
@@ -216,15 +231,19 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
     before/after comparison; without it the recording's last ``holdout_fraction`` is held out.
     """
     clock = time.perf_counter()
-    rec, dt = check_recording(recording, source, settings.lead_in_s)
+    rec, dt = check_recording(recording, source, settings.lead_in_s,
+                              0.0 if validation is not None else settings.holdout_fraction)
     if validation is not None:
-        validation, _ = check_recording(validation, "<validation>", settings.lead_in_s)
+        validation, _ = check_recording(validation, "<validation>", settings.lead_in_s, 0.0)
     base = named_structure(baseline) if isinstance(baseline, str) else baseline
     fs = 1.0 / dt
     n = len(rec)
     lead = int(round(settings.lead_in_s * fs))
-    hold = n if validation is not None else \
-        lead + int(round((n - lead) * (1.0 - settings.holdout_fraction)))
+    # the analysis stops half a second before the record's end (the zero-phase filters'
+    # end effects) or where the held-out tail starts
+    end = n - int(round(0.5 * fs))
+    hold = end if validation is not None else \
+        lead + int(round((end - lead) * (1.0 - settings.holdout_fraction)))
     fit_stop = min(hold, lead + int(round(settings.fit_seconds * fs)))
     t = rec["time"].to_numpy()
     lowpass = settings.lowpass_hz or filter_cutoff(rec["rel_acc"].to_numpy(), fs)
@@ -336,10 +355,10 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
             vlead = int(round(settings.lead_in_s / dt))
             vb, vr = validation["base_acc"].to_numpy(), validation["rel_acc"].to_numpy()
             vt = validation["time"].to_numpy()
-            section, data = (vlead, len(validation)), "validation"
-        elif hold < n - 8:
+            section, data = (vlead, len(validation) - int(round(0.5 * fs))), "validation"
+        elif hold < end - 8:
             vb, vr, vt = rec["base_acc"].to_numpy(), rec["rel_acc"].to_numpy(), t
-            section, data = (hold, n), "holdout"
+            section, data = (hold, end), "holdout"
         else:
             section = None
         if section is not None:
@@ -377,7 +396,7 @@ def quick_detect(recording: pd.DataFrame, baseline: str | ModelStructure,
     """Detection and location only, with the baseline's MAP and Laplace posterior instead of
     TMCMC (seconds, not minutes): the first step of :func:`diagnose` for screening many
     recordings. The whole recording after the lead-in is analysed (nothing held out)."""
-    rec, dt = check_recording(recording, "<recording>", settings.lead_in_s)
+    rec, dt = check_recording(recording, "<recording>", settings.lead_in_s, 0.0)
     base = named_structure(baseline) if isinstance(baseline, str) else baseline
     fs = 1.0 / dt
     lead = int(round(settings.lead_in_s * fs))
@@ -418,15 +437,16 @@ def diagnose_study(recording_df: pd.DataFrame, baseline: str, known: Mapping[str
     """The study's step for one baseline (a Snakemake rule's body).
 
     ``lead_in``/``samples`` (config preprocess.training_lead_in / training_samples) restrict
-    the analysis to the study's training window: the recording is cut at lead_in + samples
-    and the lead-in becomes the diagnosis's; with a validation record nothing of the training
-    record is held out. ``posterior``: the study's TMCMC posterior of the baseline (optional;
+    the analysis to the study's training window: the recording is cut half a second after
+    lead_in + samples (the filters' end effects fall there) and the lead-in becomes the
+    diagnosis's; with a validation record nothing of the training record is held out. ``posterior``: the study's TMCMC posterior of the baseline (optional;
     the diagnosis samples its own under its likelihood otherwise).
     """
     rec = recording_df
     if lead_in is not None:
         fs = 1.0 / float(np.median(np.diff(rec["time"].to_numpy())))
-        stop = len(rec) if samples is None else min(len(rec), lead_in + samples)
+        stop = len(rec) if samples is None else \
+            min(len(rec), lead_in + samples + int(round(0.5 * fs)))
         rec = rec.iloc[:stop].reset_index(drop=True)
         settings = replace(settings, lead_in_s=lead_in / fs,
                            fit_seconds=max(settings.fit_seconds, (stop - lead_in) / fs))
