@@ -17,7 +17,6 @@ Rates carry Wilson score intervals (95 %). The goals of the issue: named correct
 from __future__ import annotations
 
 import logging
-import math
 import time
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
@@ -56,91 +55,31 @@ def run_diagnosis(recording: pd.DataFrame, baseline: str, known: Mapping[str, fl
     ``locations``, ``fit`` (the baseline's parameters), ``p_value``, ``runtime_s``,
     ``implementation``.
 
-    THE ONE PLACE THAT KNOWS THE DIAGNOSIS'S API. Until ``harvester.diagnosis`` has its
-    top-level entry point, this composes its parts (see :func:`_diagnose_from_parts`); when
-    it lands, only this function changes. ``fast``: fewer noise replicates and MAP starts
-    (for the small grid).
+    THE ONE PLACE THAT KNOWS THE DIAGNOSIS'S API: it runs ``harvester.diagnosis.diagnose``
+    (TMCMC confirmation included; ``fast``: ``DiagnosisSettings.fast`` with 15 s fitted, for
+    the grid). ``implementation`` in the result says which ran.
     """
+    from harvester.diagnosis.run import DiagnosisSettings, diagnose
+    from harvester.priors import PriorSpec
+
     start = time.perf_counter()
-    out = _diagnose_from_parts(recording, baseline, known, seed=seed, fast=fast,
-                               lead_in=lead_in, lowpass_hz=lowpass_hz,
-                               filter_order=filter_order, priors=priors, candidates=candidates)
+    dt = float(np.median(np.diff(recording["time"].to_numpy())))
+    common = dict(seed=seed, lead_in_s=lead_in * dt, lowpass_hz=lowpass_hz,
+                  filter_order=filter_order, figures=False,
+                  candidates=tuple(candidates) if candidates else None)
+    settings = DiagnosisSettings.fast(fit_seconds=15.0, **common) if fast \
+        else DiagnosisSettings(**common)
+    given = {"sigma": SIGMA_PRIOR, **(priors or {})}
+    specs = {n: p if isinstance(p, PriorSpec) else PriorSpec(name=n, **p)
+             for n, p in given.items()}
+    out = diagnose(recording, baseline, known, specs, settings=settings).to_dict()
     out["runtime_s"] = time.perf_counter() - start
+    out["implementation"] = "harvester.diagnosis.diagnose" + (" (fast)" if fast else "")
     return out
 
 
 #: Prior of the noise sd when none is given: the study's (config ``priors.sigma``).
 SIGMA_PRIOR = {"mean": 0.07, "sd": 0.03, "unit": "m/s^2"}
-
-
-def _diagnose_from_parts(recording: pd.DataFrame, baseline: str, known: Mapping[str, float],
-                         seed: int, fast: bool, lead_in: int, lowpass_hz: float | None,
-                         filter_order: int, priors: Mapping[str, Any] | None,
-                         candidates: Sequence[str] | None) -> dict[str, Any]:
-    """Interim diagnosis from ``harvester.diagnosis``'s parts (until its entry point lands).
-
-    MAP of the baseline through the measurement chain (eq. 10 tempered by 1 / tau, tau the
-    integrated autocorrelation time of a first fit's residual), Laplace draws as the
-    posterior, then ``detect`` with the library's candidates. Verdict: the calibrated
-    p-value below alpha. ``missing``: candidates whose own calibrated p-value is below
-    alpha, smallest p first (ties: larger statistic first).
-    """
-    from harvester.diagnosis.baseline import (baseline_state, chain_problem, fit_map,
-                                              integrated_autocorrelation_time)
-    from harvester.diagnosis.detect import DetectionSettings, detect
-    from harvester.diagnosis.signatures import candidate_terms
-    from harvester.identify import make_problem
-    from harvester.priors import PriorSpec
-
-    n = len(recording)
-    fs = 1.0 / float(recording["time"].iloc[1] - recording["time"].iloc[0])
-    stop = n - int(round(0.5 * fs))  # the zero-phase filter's end effect stays outside
-    window = (int(lead_in), stop)
-    problem = make_problem(recording, baseline, dict(known), window=window)
-    spec = {"sigma": PriorSpec(name="sigma", **SIGMA_PRIOR)}
-    for name, p in (priors or {}).items():
-        spec[name] = p if isinstance(p, PriorSpec) else PriorSpec(name=name, **p)
-    n_starts = 12 if fast else 48
-    first = fit_map(chain_problem(problem, 1.0, lowpass_hz, filter_order), spec,
-                    n_starts=n_starts, seed=seed)
-    tau = integrated_autocorrelation_time(first.residual[window[0]:window[1]])
-    cp = chain_problem(problem, 1.0 / tau, lowpass_hz, filter_order)
-    fit = fit_map(cp, spec, n_starts=n_starts, seed=seed)
-    state = baseline_state(cp, fit.samples(100 if fast else 400, seed=seed))
-    names = candidate_terms(problem.structure.terms,
-                            None if candidates is None else tuple(candidates))
-    wanted = {"bootstrap": 100 if fast else 400, "chain_components": 20 if fast else 100,
-              "seed": seed}  # the diagnosis's settings change while it is written: pass known ones
-    settings = DetectionSettings(**{k: v for k, v in wanted.items()
-                                    if k in DetectionSettings.__dataclass_fields__})
-    det = detect(state, window, spec, names, settings)
-    ranked = sorted(det.candidates, key=lambda c: (c.p_value, -c.statistic))
-    missing = [c.effect for c in ranked if c.p_value < det.alpha] if det.significant else []
-    w_flag = det.window_stats.z > det.window_stats.threshold()
-    r_flag = det.region_stats.z > det.region_stats.threshold()
-    return {
-        "implementation": "interim: harvester.detection._diagnose_from_parts",
-        "baseline": baseline,
-        "verdict": "missing_physics" if det.significant else "adequate",
-        "p_value": det.p_value,
-        "alpha": det.alpha,
-        "family_p": det.family_p,
-        "missing": missing,
-        "candidates": [{"effect": c.effect, "label": c.label, "p_value": c.p_value, "z": c.z,
-                        "statistic": c.statistic, "strength": c.strength,
-                        "strength_se": c.strength_se, "explained_share": c.explained_share}
-                       for c in ranked],
-        "locations": {
-            "windows_s": [b for b, f in zip(det.windows.bounds_s, w_flag) if f],
-            "regions": [r for r, f in zip(det.regions.names, r_flag) if f],
-        },
-        "fit": {"parameters": list(cp.parameter_names), "map": fit.theta.tolist(),
-                "temper": cp.temper, "sigma": det.sigma,
-                "conflicts": [c.parameter for c in det.conflicts if c.conflict]},
-    }
-
-
-# --------------------------------------------------------------------------- scoring
 
 
 def wilson_interval(k: int | np.ndarray, n: int | np.ndarray, level: float = 0.95
