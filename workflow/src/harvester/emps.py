@@ -55,7 +55,7 @@ from harvester.daq import sha256 as file_sha256
 from harvester.errors import DataError
 from harvester.likelihood import Problem
 from harvester.physics import Layout, step_rates, term
-from harvester.simulate import BLOW_UP, MAX_SUBSTEPS, RATE_H, Simulation, _rhs
+from harvester.simulate import BLOW_UP, MAX_SUBSTEPS, RATE_H, Simulation, _rhs, rk4_step
 from harvester.structures import ModelStructure
 
 log = logging.getLogger("harvester.emps")
@@ -240,18 +240,7 @@ def _closed_loop_one(qg, dist, dt, q0, gtau, kp, kv, p, codes, poff, soff, n_sta
         if i == n - 1:
             break
         for _ in range(n_sub):
-            _rhs(s, f, p, codes, poff, soff, k1, True)
-            for e in range(n_states):
-                tmp[e] = s[e] + 0.5 * h * k1[e]
-            _rhs(tmp, f, p, codes, poff, soff, k2, True)
-            for e in range(n_states):
-                tmp[e] = s[e] + 0.5 * h * k2[e]
-            _rhs(tmp, f, p, codes, poff, soff, k3, True)
-            for e in range(n_states):
-                tmp[e] = s[e] + h * k3[e]
-            _rhs(tmp, f, p, codes, poff, soff, k4, True)
-            for e in range(n_states):
-                s[e] += h / 6.0 * (k1[e] + 2.0 * k2[e] + 2.0 * k3[e] + k4[e])
+            rk4_step(s, f, 0.0, h, p, codes, poff, soff, k1, k2, k3, k4, tmp, True)
         for e in range(n_states):
             if not (abs(s[e]) < BLOW_UP):
                 return False

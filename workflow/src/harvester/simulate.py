@@ -126,6 +126,24 @@ def _rhs(s, u, p, codes, poff, soff, ds, force_input):
 
 
 @nb.njit(cache=True, error_model="numpy")
+def rk4_step(s, u0, du, h, p, codes, poff, soff, k1, k2, k3, k4, tmp, force_input):
+    """One classical RK4 step of length h in place on s; the input goes from u0 to u0 + du."""
+    n_states = s.shape[0]
+    _rhs(s, u0, p, codes, poff, soff, k1, force_input)
+    for e in range(n_states):
+        tmp[e] = s[e] + 0.5 * h * k1[e]
+    _rhs(tmp, u0 + 0.5 * du, p, codes, poff, soff, k2, force_input)
+    for e in range(n_states):
+        tmp[e] = s[e] + 0.5 * h * k2[e]
+    _rhs(tmp, u0 + 0.5 * du, p, codes, poff, soff, k3, force_input)
+    for e in range(n_states):
+        tmp[e] = s[e] + h * k3[e]
+    _rhs(tmp, u0 + du, p, codes, poff, soff, k4, force_input)
+    for e in range(n_states):
+        s[e] += h / 6.0 * (k1[e] + 2.0 * k2[e] + 2.0 * k3[e] + k4[e])
+
+
+@nb.njit(cache=True, error_model="numpy")
 def _simulate_one(yb, dt, p, codes, poff, soff, n_states, n_sub, out_acc, out_z, out_v,
                   force_input):
     """Integrate one particle from rest; returns False if the state blew up."""
@@ -144,19 +162,8 @@ def _simulate_one(yb, dt, p, codes, poff, soff, n_states, n_sub, out_acc, out_z,
         y0 = yb[i]
         dy = (yb[i + 1] - y0) / n_sub
         for sub in range(n_sub):
-            ya = y0 + dy * sub
-            _rhs(s, ya, p, codes, poff, soff, k1, force_input)
-            for e in range(n_states):
-                tmp[e] = s[e] + 0.5 * h * k1[e]
-            _rhs(tmp, ya + 0.5 * dy, p, codes, poff, soff, k2, force_input)
-            for e in range(n_states):
-                tmp[e] = s[e] + 0.5 * h * k2[e]
-            _rhs(tmp, ya + 0.5 * dy, p, codes, poff, soff, k3, force_input)
-            for e in range(n_states):
-                tmp[e] = s[e] + h * k3[e]
-            _rhs(tmp, ya + dy, p, codes, poff, soff, k4, force_input)
-            for e in range(n_states):
-                s[e] += h / 6.0 * (k1[e] + 2.0 * k2[e] + 2.0 * k3[e] + k4[e])
+            rk4_step(s, y0 + dy * sub, dy, h, p, codes, poff, soff, k1, k2, k3, k4, tmp,
+                     force_input)
         ok = True
         for e in range(n_states):
             if not (abs(s[e]) < BLOW_UP):
