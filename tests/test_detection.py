@@ -223,3 +223,16 @@ def test_small_grid_runs_end_to_end(tmp_path):
     assert (d / "figures/detection_rates.png").stat().st_size > 10_000
     res = pd.read_csv(d / "scenario_results.csv")
     assert np.allclose(res.loc[~res["effect_free"], "contribution_ratio"], 0.5, rtol=0.01)
+
+
+def test_tied_counts_an_effect_reported_indistinguishable_from_the_first():
+    d = {**_diag("stribeck_friction", "coulomb_friction"),
+         "indistinguishable": [["stribeck_friction", "coulomb_friction"]]}
+    rows = det.results_table([(_truth("coulomb_friction", 0.5, 0, "linear"), d),
+                              (_truth("end_stop", 0.5, 0), _diag("cubic_stiffness"))])
+    by = rows.set_index("effect")
+    assert not by.loc["coulomb_friction", "named"] and by.loc["coulomb_friction", "tied"]
+    assert not by.loc["end_stop", "tied"]
+    table = det.detection_table(rows).set_index("effect")
+    assert table.loc["coulomb_friction", "tied_rate"] == 1.0
+    assert table.loc["end_stop", "tied_rate"] == 0.0

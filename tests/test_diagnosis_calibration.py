@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 
 from harvester.diagnosis import DiagnosisSettings, diagnose, quick_detect
-from harvester.diagnosis.synthetic import (TABLE1_KNOWN, TANH_TABLE5, concealed_recording,
-                                           measured_recording)
+from harvester.diagnosis.synthetic import TABLE1_KNOWN, TANH_TABLE5, measured_recording
 from harvester.priors import PriorSpec
+from harvester.scenarios import ScenarioSettings, make_scenario
 
 pytestmark = [pytest.mark.slow,
               pytest.mark.filterwarnings("ignore::UserWarning", "ignore::RuntimeWarning")]
@@ -70,6 +70,8 @@ def test_detection_false_alarms_over_60_seeds():
                                     "asymmetric_friction", "stribeck_friction",
                                     "inertia_error"])
 def test_detection_power_at_half_the_noise_rms(effect):
-    found = [run_detection(concealed_recording(effect, 0.5, 500 + seed, 20.0)[0],
-                           seed)[0].significant for seed in range(4)]
+    settings = ScenarioSettings(duration_s=20.0)
+    found = [run_detection(make_scenario(effect, 0.5, 500 + seed, settings,
+                                         masking=False).recording, seed)[0].significant
+             for seed in range(4)]
     assert sum(found) >= 3, f"{effect}: detected in {sum(found)} of 4"

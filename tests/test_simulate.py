@@ -69,7 +69,7 @@ TERM_PARAMS = {
     "end_stop": [0.01, 5000.0],
     "backlash": [5e-4, 2e5],
     "hysteresis": [2.0, 2e4],
-    "unmodelled_mode": [6.0, 0.05, 0.5],
+    "unmodelled_mode": [6.0, 0.05, 0.5, 1.0],
     "inertia_error": [0.8],
     "offset_force": [3.0],
 }
@@ -117,7 +117,7 @@ def test_backlash_without_gap_is_rigid(base_acc):
 
 def test_light_secondary_mode_is_invisible(base_acc):
     lin = simulate(Layout.of([]), BASE, base_acc, DT).rel_acc[0]
-    mode = simulate(Layout.of(["unmodelled_mode"]), BASE + [6.0, 0.05, 1e-6], base_acc,
+    mode = simulate(Layout.of(["unmodelled_mode"]), BASE + [6.0, 0.05, 1e-6, 1.0], base_acc,
                     DT).rel_acc[0]
     np.testing.assert_allclose(mode, lin, atol=1e-5)
 

@@ -6,7 +6,9 @@ into the detection table, the confusion matrix and the false-alarm rate.
 
 Scoring one scenario whose true effect is e (``named``): the diagnosis names e correctly when
 e (or a name :data:`ACCEPTED` declares equivalent) is FIRST in its ``missing`` list.
-Also reported: ``top2`` (e among the first two) and ``flagged`` (verdict "missing_physics",
+Also reported: ``tied`` (e first, or in the group of effects the diagnosis reported as
+indistinguishable by evidence from the first: it said it could not tell them apart),
+``top2`` (e among the first two) and ``flagged`` (verdict "missing_physics",
 whatever is named). On an effect-free scenario, a false alarm is the verdict
 "missing_physics".
 
@@ -122,10 +124,19 @@ def score(truth: Mapping[str, Any], diagnosis: Mapping[str, Any],
         "invisible": bool(truth.get("invisible", True)),
         "verdict": diagnosis["verdict"], "flagged": flagged, "named_effect": named,
         "named": (not effect_free) and flagged and bool(missing) and missing[0] in ok,
+        "tied": (not effect_free) and flagged and bool(ok & _first_group(diagnosis, missing)),
         "top2": (not effect_free) and flagged and bool(ok & set(missing[:2])),
         "p_value": float(diagnosis.get("p_value", np.nan)),
         "runtime_s": float(diagnosis.get("runtime_s", np.nan)),
     }
+
+
+def _first_group(diagnosis: Mapping[str, Any], missing: list[str]) -> set[str]:
+    """The first named effect and those reported indistinguishable from it."""
+    if not missing:
+        return set()
+    groups = [set(g) for g in diagnosis.get("indistinguishable") or [] if missing[0] in g]
+    return set().union({missing[0]}, *groups)
 
 
 def results_table(pairs: Iterable[tuple[Mapping[str, Any], Mapping[str, Any]]],
@@ -154,6 +165,7 @@ def detection_table(results: pd.DataFrame, goal_ratio: float = GOAL_RATIO,
         rows.append({
             "effect": effect, "ratio": ratio, "baseline": g["baseline"].iloc[0], "seeds": n,
             "named": k, "named_rate": k / n, "named_lo": float(lo), "named_hi": float(hi),
+            "tied_rate": float(g["tied"].mean()) if "tied" in g else np.nan,
             "top2_rate": float(g["top2"].mean()), "flagged_rate": float(g["flagged"].mean()),
             "contribution_ratio_mean": float(g["contribution_ratio"].mean()),
             "unabsorbed_to_noise_mean": float(g["unabsorbed_to_noise"].mean()),

@@ -106,8 +106,15 @@ _TERMS: tuple[Term, ...] = (
         Parameter("f_mode", "Hz", 5.0, 3.0, 0.1, "natural frequency of the secondary mode"),
         Parameter("zeta_mode", "-", 0.05, 0.05, 1e-3, "damping ratio of the secondary mode"),
         Parameter("mass_mode", "kg", 0.5, 0.5, 0.0, "modal mass of the secondary mode"),
-    ), n_states=2, equation="u'' + 2 zeta w_n u' + w_n^2 u = -x'', force on mass m_2 (w_n^2 u + 2 zeta w_n u')",
-        description="secondary resonance attached to the mass", kind="mode"),
+        Parameter("drive_base", "-", 0.5, 0.5, 0.0,
+                  "share of the base acceleration in the mode's drive: 1 for a mode attached "
+                  "to the mass (driven by its absolute acceleration x'' = z'' + y''), 0 for "
+                  "one on the screw side (a rotor on a flexible coupling, driven by z'')"),
+    ), n_states=2,
+        equation="u'' + 2 zeta w_n u' + w_n^2 u = -(z'' + drive_base y''), force on the mass "
+                 "m_2 (w_n^2 u + 2 zeta w_n u')",
+        description="secondary resonance inside the band, on the mass or the screw side",
+        kind="mode"),
     Term("offset_force", 12, (
         Parameter("F_offset", "N", 0.0, 5.0, None, "constant force (gravity, cable, bias)"),
     ), equation="f = F_offset", description="constant force offset", kind="mass"),

@@ -49,7 +49,9 @@ hysteresis                Bouc-Wen pre-sliding force, n = 2:
 unmodelled_mode           a secondary rotor on a flexible coupling to the screw: driven by the
                           relative motion z (m_2 u'' = k_2 (z - u) + c_2 (z' - u')), strength
                           m_2, f_mode drawn in [3, 18] Hz, zeta in [0.02, 0.1]
-                          [a mode attached to the mass, driven by its absolute acceleration]
+                          [a mode driven by z'' + drive_base y'': the rotor is the library's
+                          drive_base = 0 case in another parametrisation (m_2, k_2, c_2);
+                          the library's default prior centres on 0.5, between mass and screw]
 inertia_error             extra mass dm on the oscillating mass: m and M both change, so the
                           drive -m y'' changes too; sign drawn [M only]
 ========================= ====================================================================
@@ -369,7 +371,7 @@ FAMILIES: dict[str, Family] = {f.effect: f for f in (
     Family("unmodelled_mode", ROTOR_MODE, "mass_2", "kg",
            "secondary rotor (equivalent mass m_2) on a flexible coupling to the screw, "
            "f_mode drawn in [3, 18] Hz, zeta in [0.02, 0.1], driven by z",
-           "mode on the mass driven by x''", guess=0.05,
+           "mode driven by z'' + drive_base y''", guess=0.05,
            shapes=lambda rng, motion: {"f_mode": _loguniform(rng, 3.0, 18.0),
                                        "zeta": rng.uniform(0.02, 0.1)},
            shape_order=("f_mode", "zeta")),

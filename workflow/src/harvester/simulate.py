@@ -121,7 +121,7 @@ def _rhs(s, u, p, codes, poff, soff, ds, force_input):
             o = poff[j]
             wn = 2.0 * np.pi * p[o]
             ds[q] = s[q + 1]
-            ds[q + 1] = -(wn * wn * s[q] + 2.0 * p[o + 1] * wn * s[q + 1]) - (a + yb)
+            ds[q + 1] = -(wn * wn * s[q] + 2.0 * p[o + 1] * wn * s[q + 1]) - (a + p[o + 3] * yb)
     return a
 
 

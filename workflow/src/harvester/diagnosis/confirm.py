@@ -18,7 +18,9 @@ is set for the motion of the paper's rig rather than for any rig: the end stop's
 the cubic stiffness are scaled by the baseline's displacement, quadratic damping by its
 velocity, the secondary mode's frequency by the analysed band, and the pre-sliding
 (hysteresis) force is kept above 0.2 N, below which the Dahl law is too stiff to integrate in
-minutes. Priors given by the caller always win.
+minutes, and the bristle stiffness's prior (2 +- 2 kN/m, pre-sliding displacements of about
+0.1-10 mm at those forces) leaves out the stiff tail (k_hyst / F_hyst > 1e5 /m) that made one
+sampled candidate cost minutes in the grid. Priors given by the caller always win.
 """
 
 from __future__ import annotations
@@ -164,7 +166,7 @@ def candidate_priors(effect: str, scale: MotionScale, c_m_mean: float = 170.0
         out["f_mode"] = PriorSpec("f_mode", 0.5 * scale.f_high, 0.35 * scale.f_high, "Hz", 0.5)
     elif effect == "hysteresis":
         out["F_hyst"] = PriorSpec("F_hyst", 2.0, 2.0, "N", 0.2)
-        out["k_hyst"] = PriorSpec("k_hyst", 5e3, 5e3, "N/m", 100.0)
+        out["k_hyst"] = PriorSpec("k_hyst", 2e3, 2e3, "N/m", 100.0)
     return out
 
 

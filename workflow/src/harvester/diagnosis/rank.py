@@ -106,11 +106,19 @@ def rank(detection: Detection, state: BaselineState, priors: Mapping[str, PriorS
 
 
 def to_confirm(ranked: list[RankedCandidate], detection: Detection, top: int,
-               min_delta_chi2: float = 4.0) -> list[RankedCandidate]:
+               min_delta_chi2: float = 4.0, similar_extra: int = 2) -> list[RankedCandidate]:
     """The best ``top`` candidates worth sampling: significant by their score test, or
-    relieving a prior conflict, and with delta_chi2 of at least ``min_delta_chi2``."""
+    relieving a prior conflict, and with delta_chi2 of at least ``min_delta_chi2``; plus up to
+    ``similar_extra`` eligible candidates whose signatures are similar to a chosen one's (the
+    ranking cannot tell them apart, so the evidence must: a Coulomb law beside tanh and
+    Stribeck laws, say)."""
     eligible = [r for r in ranked
                 if (r.score.p_value < detection.alpha
                     or (detection.conflict and r.conflict_relief > min_delta_chi2))
                 and r.delta_chi2 >= min_delta_chi2]
-    return eligible[:top]
+    chosen = eligible[:top]
+    names = {r.effect for r in chosen}
+    similar = {e for r in chosen for e in r.similar}
+    extra = [r for r in ranked if r.effect in similar and r.effect not in names
+             and r.delta_chi2 >= min_delta_chi2]
+    return chosen + extra[:similar_extra]

@@ -82,10 +82,11 @@ PROBES: dict[str, Probe] = {p.term: p for p in (
     Probe("hysteresis", "F_hyst", lambda s: 0.5,
           shapes=lambda s: [{"k_hyst": 0.5 / d} for d in (3e-5, 3e-4)]),
     Probe("unmodelled_mode", "mass_mode", lambda s: 0.05,
-          shapes=lambda s: [{"f_mode": f, "zeta_mode": 0.15}
+          shapes=lambda s: [{"f_mode": f, "zeta_mode": 0.15, "drive_base": d}
+                            for d in (1.0, 0.0)
                             for f in _geom(1.5, 0.95 * s.f_high,
                                            1 + int(np.log(0.95 * s.f_high / 1.5)
-                                                   / np.log(1.15)))]),
+                                                   / np.log(1.2)))]),
     Probe("offset_force", "F_offset", lambda s: 0.5, signed=True),
     Probe("inertia_error", "dM", lambda s: 0.1, signed=True),
 )}
