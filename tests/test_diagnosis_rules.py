@@ -10,11 +10,11 @@ from harvester.diagnosis.run import decide_verdict
 
 def test_verdict_needs_evidence_or_a_strong_unexplained_detection():
     # a screening detection at p < 0.05 alone is not enough: it fires in 5 % of clean records
-    assert decide_verdict(0.01, accepted=False, unexplained_alpha=0.004) == "adequate"
-    assert decide_verdict(0.003, accepted=False, unexplained_alpha=0.004) == "missing_physics"
+    assert decide_verdict(0.01, accepted=False, unexplained_alpha=0.001) == "adequate"
+    assert decide_verdict(0.0005, accepted=False, unexplained_alpha=0.001) == "missing_physics"
     # an effect confirmed by evidence is enough whatever the screening said (prior conflict)
-    assert decide_verdict(0.4, accepted=True, unexplained_alpha=0.004) == "missing_physics"
-    assert decide_verdict(0.4, accepted=False, unexplained_alpha=0.004) == "adequate"
+    assert decide_verdict(0.4, accepted=True, unexplained_alpha=0.001) == "missing_physics"
+    assert decide_verdict(0.4, accepted=False, unexplained_alpha=0.001) == "adequate"
 
 
 def _ranked(effect, p, dchi2, similar=()):
