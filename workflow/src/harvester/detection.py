@@ -233,7 +233,7 @@ def detection_figure(table: pd.DataFrame, alarms: pd.DataFrame, path: str | Path
 
     from harvester.fileio import atomic_path
 
-    fig, ax = plt.subplots(figsize=(8, 5))
+    fig, ax = plt.subplots(figsize=(10, 5))
     effects = sorted(table["effect"].unique())
     cmap = plt.get_cmap("tab10")
     for i, effect in enumerate(effects):
@@ -261,7 +261,7 @@ def detection_figure(table: pd.DataFrame, alarms: pd.DataFrame, path: str | Path
     ax.set_title(f"Concealed effects named by the diagnosis (SIMULATED scenarios)\n{fa}; "
                  f"goal {goal_rate:.0%} named at {goal_ratio:g}, false alarms <= "
                  f"{goal_alarm:.0%}", fontsize=9)
-    ax.legend(fontsize=7, loc="lower right", ncol=2)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     ax.grid(alpha=0.3)
     fig.tight_layout()
     with atomic_path(path) as tmp:
