@@ -165,7 +165,7 @@ def detection_table(results: pd.DataFrame, goal_ratio: float = GOAL_RATIO,
         rows.append({
             "effect": effect, "ratio": ratio, "baseline": g["baseline"].iloc[0], "seeds": n,
             "named": k, "named_rate": k / n, "named_lo": float(lo), "named_hi": float(hi),
-            "tied_rate": float(g["tied"].mean()) if "tied" in g else np.nan,
+            "tied_rate": float(g["tied"].mean()),
             "top2_rate": float(g["top2"].mean()), "flagged_rate": float(g["flagged"].mean()),
             "contribution_ratio_mean": float(g["contribution_ratio"].mean()),
             "unabsorbed_to_noise_mean": float(g["unabsorbed_to_noise"].mean()),

@@ -51,7 +51,7 @@ class DiagnosisSettings:
     (``DetectionSettings``); evidence_alpha, indistinguishable_nats: acceptance
     (``ConfirmSettings``); unexplained_alpha: a detection that no library effect explains
     counts as missing physics only below this p-value (an effect confirmed by evidence
-    always does; see ``verdict``); lead_in_s: start of the analysis (the model starts at rest);
+    always does; see ``decide_verdict``); lead_in_s: start of the analysis (the model starts at rest);
     fit_seconds: most seconds of the recording TMCMC fits (the detection uses all but the
     holdout); holdout_fraction: share of the recording's end kept unseen when no validation
     record is given; lowpass_hz: cut-off of the zero-phase low-pass the recording went
@@ -235,7 +235,6 @@ def decide_verdict(p_value: float, accepted: bool, unexplained_alpha: float) -> 
     detection that no effect explains.
     """
     return "missing_physics" if accepted or p_value < unexplained_alpha else "adequate"
-
 
 
 def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
