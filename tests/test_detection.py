@@ -214,7 +214,7 @@ def test_small_grid_runs_end_to_end(tmp_path):
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=1800,
                           env=dict(os.environ, PYTHONWARNINGS="ignore"))
     assert proc.returncode == 0, (proc.stdout + proc.stderr)[-6000:]
-    d = workdir / "results/detection"
+    d = workdir / "results/detection/small"
     table = pd.read_csv(d / "detection_table.csv")
     assert set(table["effect"]) == {"end_stop", "coulomb_friction"}
     assert (table["seeds"] == 1).all()

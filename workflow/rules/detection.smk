@@ -1,9 +1,11 @@
 # Proof on concealed effects (target `detection_all`): scenarios of the virtual device carrying
 # one effect whose contribution to z'' is a set fraction of the noise RMS, each diagnosed;
-# detection table, confusion matrix, false-alarm rate. Grid: config `detection.grid`
-# (small: a laptop, minutes; full: a cluster, `--profile profiles/slurm`).
+# detection table, confusion matrix, false-alarm rate under results/detection/{grid}/. Grid:
+# config `detection.grid` (small: a laptop, minutes; full: a cluster, `--profile profiles/slurm`).
 DETECTION = config.get("detection", {})
-DET = "results/detection"
+#: Each grid writes under its own directory, so that grids never mix their scenarios.
+DET = f"results/detection/{DETECTION.get('grid', 'small')}"
+DET_LOG = f"logs/detection/{DETECTION.get('grid', 'small')}"
 
 
 def detection_grid():
@@ -60,7 +62,7 @@ rule detection_scenario:
         mem_mb=1000,
         runtime=10,
     log:
-        "logs/detection/scenario_{effect}_r{ratio}_s{seed}.log",
+        f"{DET_LOG}/scenario_{{effect}}_r{{ratio}}_s{{seed}}.log",
     conda:
         ENV
     script:
@@ -83,7 +85,7 @@ rule diagnose_scenario:
         mem_mb=3000,
         runtime=lambda w: 15 if detection_grid()["fast"] else 60,
     log:
-        "logs/detection/diagnose_{effect}_r{ratio}_s{seed}.log",
+        f"{DET_LOG}/diagnose_{{effect}}_r{{ratio}}_s{{seed}}.log",
     conda:
         ENV
     script:
@@ -107,7 +109,7 @@ rule detection_table:
         accepted=lambda w: DETECTION.get("accepted", {}),
         goal=lambda w: DETECTION["goal"],
     log:
-        "logs/detection/table.log",
+        f"{DET_LOG}/table.log",
     conda:
         ENV
     script:
@@ -124,7 +126,7 @@ rule detection_figure:
     params:
         goal=lambda w: DETECTION["goal"],
     log:
-        "logs/detection/figure.log",
+        f"{DET_LOG}/figure.log",
     conda:
         ENV
     script:

@@ -93,9 +93,14 @@ _TERMS: tuple[Term, ...] = (
     ), equation="f = k_stop (|z| - gap_stop)_+ sgn(z)", description="end stop beyond a clearance",
         kind="mass"),
     Term("backlash", 8, (
-        Parameter("gap_backlash", "m", 5e-4, 5e-4, 0.0, "half dead zone in the screw-nut coupling"),
-        Parameter("k_backlash", "N/m", 2e5, 1e5, 1.0, "coupling stiffness in contact"),
-    ), n_states=2, equation="coupling force k_backlash dz(d, gap); J r'' = F_b - c_m r' - f(r')",
+        Parameter("gap_backlash", "m", 1e-5, 1e-5, 0.0,
+                  "half dead zone in the screw-nut coupling (axial play of an unloaded ball "
+                  "nut: a few to tens of micrometres)"),
+        Parameter("k_backlash", "N/m", 1e7, 1e7, 1e6,
+                  "axial contact stiffness of the screw-nut coupling (ball nuts: 1e7-1e9)"),
+    ), n_states=2, equation="coupling force F_b = k_backlash dz(d, gap) + c_b d' in contact "
+                            "(compressive only), c_b at damping ratio 0.5 on m J / (m + J); "
+                            "J r'' = F_b - c_m r' - f(r')",
         description="dead zone between the mass and the screw-side inertia", kind="coupling"),
     Term("hysteresis", 9, (
         Parameter("F_hyst", "N", 2.0, 2.0, 1e-3, "saturation force of the pre-sliding branch"),
@@ -168,8 +173,11 @@ class Layout:
         return self.parameter_names.index(name)
 
 
-def step_rates(layout: Layout, params: np.ndarray) -> np.ndarray:
+def step_rates(layout: Layout, params: np.ndarray, v_bound: float = V_BOUND) -> np.ndarray:
     """Per-particle bound on the fastest rate (1/s) of the equations of motion.
+
+    ``v_bound`` (m/s): the largest velocity assumed for the velocity-dependent rates (Dahl
+    relaxation, quadratic damping); a caller that knows the motion gives a tighter one.
 
     The largest of: damping rate (d force / d velocity) / mass, natural frequency
     sqrt(stiffness / mass) of every spring, contact, coupling and secondary mode, and the
@@ -193,7 +201,7 @@ def step_rates(layout: Layout, params: np.ndarray) -> np.ndarray:
         elif t.name == "stribeck_friction":
             damp += a / V_EPS + 2.0 * a / np.maximum(np.abs(p[:, o + 1]), 1e-6)
         elif t.name == "quadratic_damping":
-            damp += 2.0 * a * V_BOUND
+            damp += 2.0 * a * v_bound
         elif t.name == "cubic_stiffness":
             stiff += 3.0 * a * Z_BOUND**2
         elif t.name == "end_stop":
@@ -201,12 +209,13 @@ def step_rates(layout: Layout, params: np.ndarray) -> np.ndarray:
         elif t.name == "backlash":
             m, j = np.abs(p[:, 1]), np.maximum(mass - np.abs(p[:, 1]), 1e-3)
             reduced = m * j / (m + j)
-            # x4: the contact switches on and off, so RK4 needs finer steps than the frequency says
-            rate = np.maximum(rate, 4.0 * np.sqrt(np.abs(p[:, o + 1]) / reduced))
+            # x8: the contact switches on and off and RK4 drops to first order at each touch
+            # (x4 left 1.2 % error in z'' through a 20 Hz low-pass in a rattling case, x8 0.3 %)
+            rate = np.maximum(rate, 8.0 * np.sqrt(np.abs(p[:, o + 1]) / reduced))
             rate = np.maximum(rate, damp / j)
         elif t.name == "hysteresis":
             stiff += np.abs(p[:, o + 1])
-            rate = np.maximum(rate, np.abs(p[:, o + 1]) * V_BOUND / np.maximum(a, 1e-6))
+            rate = np.maximum(rate, np.abs(p[:, o + 1]) * v_bound / np.maximum(a, 1e-6))
         elif t.name == "unmodelled_mode":
             wn = 2 * np.pi * a
             ratio = np.abs(p[:, o + 2]) / mass

@@ -359,7 +359,7 @@ FAMILIES: dict[str, Family] = {f.effect: f for f in (
     Family("backlash", BACKLASH, "gap", "m",
            "gap in the screw-nut coupling; Tsuji contact k_c delta^1.5 + c_c delta^0.25 delta' "
            "(compressive), k_c = 1e11 N/m^1.5, c_c = 1e5 N s/m^1.25",
-           "k_backlash dz(d, gap) (1 + 100 d'), linear with Hunt-Crossley damping", guess=2e-5,
+           "k_backlash dz(d, gap) + c_b d' in contact (linear, Kelvin-Voigt)", guess=2e-5,
            shapes=lambda rng, motion: {"k_contact": 1e11, "c_contact": 1e5},
            shape_order=("k_contact", "c_contact")),
     Family("hysteresis", BOUC_WEN, "F_hyst", "N",

@@ -107,7 +107,8 @@ def chain_problem(problem: Problem, temper: float = 1.0, lowpass_hz: float | Non
     end = min(len(problem.rel_acc), stop + int(round(CHAIN_PAD_S / problem.dt)))
     return ChainProblem(structure or problem.structure, problem.base_acc[:end],
                         problem.rel_acc[:end], problem.dt, dict(problem.known), (start, stop),
-                        temper=float(temper), lowpass_hz=lowpass_hz, filter_order=filter_order)
+                        temper=float(temper), v_bound=problem.v_bound, lowpass_hz=lowpass_hz,
+                        filter_order=filter_order)
 
 
 # --------------------------------------------------------------------------- MAP fit

@@ -78,7 +78,7 @@ PROBES: dict[str, Probe] = {p.term: p for p in (
     Probe("end_stop", "k_stop", lambda s: 1.0 / s.z,
           shapes=lambda s: [{"gap_stop": s.z_quantiles[q]} for q in (0.5, 0.75, 0.9, 0.97)]),
     Probe("backlash", "gap_backlash", lambda s: 0.0, reference="zero", amount_is_shape=True,
-          shapes=lambda s: [{"gap_backlash": g * s.z} for g in (0.005, 0.02)]),
+          shapes=lambda s: [{"gap_backlash": g} for g in (2e-6, 1e-5)]),
     Probe("hysteresis", "F_hyst", lambda s: 0.5,
           shapes=lambda s: [{"k_hyst": 0.5 / d} for d in (3e-5, 3e-4)]),
     Probe("unmodelled_mode", "mass_mode", lambda s: 0.05,
