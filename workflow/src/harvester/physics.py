@@ -173,17 +173,19 @@ class Layout:
         return self.parameter_names.index(name)
 
 
-def step_rates(layout: Layout, params: np.ndarray, v_bound: float = V_BOUND) -> np.ndarray:
+def step_rates(layout: Layout, params: np.ndarray, v_bound: float | None = None) -> np.ndarray:
     """Per-particle bound on the fastest rate (1/s) of the equations of motion.
 
     ``v_bound`` (m/s): the largest velocity assumed for the velocity-dependent rates (Dahl
-    relaxation, quadratic damping); a caller that knows the motion gives a tighter one.
+    relaxation, quadratic damping); None: V_BOUND. A caller that knows the motion gives a
+    tighter one.
 
     The largest of: damping rate (d force / d velocity) / mass, natural frequency
     sqrt(stiffness / mass) of every spring, contact, coupling and secondary mode, and the
     relaxation rate of internal friction states. Used only to choose the integrator's sub-step.
     """
     p = np.atleast_2d(np.asarray(params, dtype=float))
+    v_bound = V_BOUND if v_bound is None else v_bound
     mass = np.abs(p[:, 0]).copy()
     for t, o in zip(layout.terms, layout.param_offsets):
         if t.name == "inertia_error":

@@ -30,7 +30,7 @@ BLOW_UP = 1.0e6
 #: Damping ratio of the backlash contact (Kelvin-Voigt, on the reduced mass m J / (m + J)).
 #: Without it (a Hunt-Crossley law, damping ~ penetration) the contact rang and chattered: at
 #: zero clearance the coupling was an undamped mode, and the log-likelihood of a record of the
-#: baseline itself fell by thousands at the library's stiffness (measured, 2026-11-23).
+#: baseline itself fell by thousands at the library's stiffness (measured).
 BACKLASH_ZETA = 0.5
 
 
@@ -203,8 +203,7 @@ def substeps(layout: Layout, params: np.ndarray, dt: float,
              v_bound: float | None = None) -> np.ndarray:
     """Sub-steps per sample for each particle so that fastest rate x h <= RATE_H
     (``v_bound``: largest velocity in m/s, ``physics.step_rates``; None: its default)."""
-    rate = step_rates(layout, params) if v_bound is None else \
-        step_rates(layout, params, v_bound)
+    rate = step_rates(layout, params, v_bound)
     n = np.ceil(rate * dt / RATE_H)
     n = np.where(np.isfinite(n), n, MAX_SUBSTEPS)
     return np.clip(n, MIN_SUBSTEPS, MAX_SUBSTEPS).astype(np.int64)

@@ -31,6 +31,7 @@ from harvester.diagnosis.signatures import candidate_terms, motion_scale
 from harvester.diagnosis.spectral import filter_cutoff
 from harvester.errors import DataError
 from harvester.identify import make_problem, posterior_theta
+from harvester.likelihood import Problem
 from harvester.posterior import parameter_names as idata_parameter_names
 from harvester.priors import PriorSpec
 from harvester.structures import ModelStructure, structure as named_structure
@@ -219,7 +220,7 @@ def default_priors(structure: ModelStructure, sigma: float) -> dict[str, PriorSp
 V_BOUND_MARGIN = 3.0
 
 
-def velocity_bound(problem, theta: np.ndarray) -> float | None:
+def velocity_bound(problem: Problem, theta: np.ndarray) -> float | None:
     """V_BOUND_MARGIN x the largest |z'| (m/s) of the structure at ``theta`` (one row) over
     the whole record, for the integrator's sub-step choice (``physics.step_rates``; its
     default, 1 m/s, makes stiff pre-sliding candidates take ten times the steps they need on
