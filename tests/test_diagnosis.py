@@ -69,6 +69,14 @@ def test_chain_problem_without_chain_is_eq10_and_tempering_scales_it():
     assert np.std(r) < 0.05
 
 
+def test_quick_detect_without_priors_uses_the_librarys():
+    # priors=None: the library's priors, sigma's scaled to the MAP's residual (as documented)
+    df, _ = measured_recording(("tanh_friction",), {**TABLE1_KNOWN, **TANH_TABLE5}, 8.0, 2)
+    det, _ = quick_detect(df, "tanh", TABLE1_KNOWN, None,
+                          DiagnosisSettings(bootstrap=50, artifact_components=10))
+    assert 0.0 < det.p_value <= 1.0 and det.sigma > 0.0
+
+
 def test_tempering_is_the_share_of_independent_samples_of_band_limited_noise():
     rng = np.random.default_rng(3)
     noise = lowpass(rng.standard_normal(30 * 256), FS, 20.0, 8)

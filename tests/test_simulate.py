@@ -70,7 +70,7 @@ TERM_PARAMS = {
     "backlash": [1e-5, 1e7],
     "hysteresis": [2.0, 2e4],
     "unmodelled_mode": [6.0, 0.05, 0.5, 1.0],
-    "inertia_error": [0.8],
+    "inertia_error": [0.8, 0.5],
     "offset_force": [3.0],
 }
 
@@ -112,9 +112,12 @@ def test_effect_changes_response(base_acc):
         assert np.std(sim - lin) > 1e-3, name
 
 
-def test_inertia_error_equals_changed_mass(base_acc):
-    a = simulate(Layout.of(["inertia_error"]), BASE + [0.8], base_acc, DT).rel_acc[0]
-    b = simulate(Layout.of([]), [13.6] + BASE[1:], base_acc, DT).rel_acc[0]
+@pytest.mark.parametrize("share", [0.0, 1.0, 0.25])
+def test_inertia_error_equals_changed_masses(base_acc, share):
+    """dM on the effective mass, m_share dM of it on the oscillating mass (drive -m y'')."""
+    a = simulate(Layout.of(["inertia_error"]), BASE + [0.8, share], base_acc, DT).rel_acc[0]
+    b = simulate(Layout.of([]), [BASE[0] + 0.8, BASE[1] + share * 0.8] + BASE[2:], base_acc,
+                 DT).rel_acc[0]
     np.testing.assert_allclose(a, b, atol=1e-12)
 
 

@@ -125,8 +125,12 @@ _TERMS: tuple[Term, ...] = (
     ), equation="f = F_offset", description="constant force offset", kind="mass"),
     Term("inertia_error", 11, (
         Parameter("dM", "kg", 0.0, 1.0, None, "error of the assumed effective mass"),
-    ), equation="M -> M + dM", description="effective mass differs from the assumed value",
-        kind="inertia"),
+        Parameter("m_share", "-", 0.5, 0.5, 0.0,
+                  "share of dM on the oscillating mass, which also drives the device (-m y''): "
+                  "1 for a payload error, 0 for an error of the screw-side inertia "
+                  "J (2 pi / l)^2 alone, above 1 when the two errors differ in sign"),
+    ), equation="M -> M + dM, m -> m + m_share dM (eq. 2: M = m + J (2 pi / l)^2)",
+        description="effective mass differs from the assumed value", kind="inertia"),
 )
 
 #: All terms by name.

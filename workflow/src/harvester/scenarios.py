@@ -53,7 +53,8 @@ unmodelled_mode           a secondary rotor on a flexible coupling to the screw:
                           drive_base = 0 case in another parametrisation (m_2, k_2, c_2);
                           the library's default prior centres on 0.5, between mass and screw]
 inertia_error             extra mass dm on the oscillating mass: m and M both change, so the
-                          drive -m y'' changes too; sign drawn [M only]
+                          drive -m y'' changes too; sign drawn [M + dM, m + m_share dM:
+                          the generator's case is m_share = 1]
 ========================= ====================================================================
 
 Effect-free scenarios (``none_tanh``, ``none_linear``; r = 0) carry no effect: they measure the
@@ -376,7 +377,8 @@ FAMILIES: dict[str, Family] = {f.effect: f for f in (
                                        "zeta": rng.uniform(0.02, 0.1)},
            shape_order=("f_mode", "zeta")),
     Family("inertia_error", EXTRA_MASS, "dm", "kg",
-           "extra mass dm on the oscillating mass (m and M both + dm)", "M -> M + dM",
+           "extra mass dm on the oscillating mass (m and M both + dm)",
+           "M -> M + dM, m -> m + m_share dM",
            guess=0.05, signed=True),
 )}
 

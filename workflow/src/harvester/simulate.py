@@ -41,12 +41,6 @@ def _rhs(s, u, p, codes, poff, soff, ds, force_input):
     The input u is the base acceleration y'' (drive -m y'') or, with ``force_input``, a force
     applied to the mass (N) with the base fixed (y'' = 0).
     """
-    if force_input:
-        drive = u
-        yb = 0.0
-    else:
-        drive = -p[1] * u
-        yb = u
     z = s[0]
     v = s[1]
     M = p[0]
@@ -57,8 +51,15 @@ def _rhs(s, u, p, codes, poff, soff, ds, force_input):
     for j in range(codes.shape[0]):
         if codes[j] == 11:
             M += p[poff[j]]
+            m += p[poff[j] + 1] * p[poff[j]]
         elif codes[j] == 8:
             backlash = j
+    if force_input:
+        drive = u
+        yb = 0.0
+    else:
+        drive = -m * u
+        yb = u
     w = v
     if backlash >= 0:
         w = v - s[soff[backlash] + 1]

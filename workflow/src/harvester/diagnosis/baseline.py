@@ -29,7 +29,7 @@ from scipy import optimize, signal
 
 from harvester.likelihood import Problem
 from harvester.priors import PriorSpec
-from harvester.pymc_models import priors_for
+from harvester.pymc_models import default_prior
 
 log = logging.getLogger("harvester.diagnosis")
 
@@ -137,8 +137,8 @@ class PointFit:
 
 
 def _prior_arrays(problem: Problem, priors: Mapping[str, PriorSpec]):
-    specs = priors_for(problem, priors)
     names = problem.structure.free_parameters
+    specs = {n: priors[n] if n in priors else default_prior(n) for n in names}
     mu = np.array([specs[n].mean for n in names])
     sd = np.array([specs[n].sd for n in names])
     lower = np.array([specs[n].lower for n in names])

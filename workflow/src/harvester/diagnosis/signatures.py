@@ -88,7 +88,8 @@ PROBES: dict[str, Probe] = {p.term: p for p in (
                                            1 + int(np.log(0.95 * s.f_high / 1.5)
                                                    / np.log(1.2)))]),
     Probe("offset_force", "F_offset", lambda s: 0.5, signed=True),
-    Probe("inertia_error", "dM", lambda s: 0.1, signed=True),
+    Probe("inertia_error", "dM", lambda s: 0.1, signed=True,
+          shapes=lambda s: [{"m_share": share} for share in (0.0, 1.0)]),
 )}
 
 
