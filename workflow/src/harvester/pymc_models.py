@@ -8,7 +8,7 @@ too; our TMCMC kernel evaluates all particles in one call.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pymc as pm
@@ -28,9 +28,12 @@ def default_prior(name: str) -> PriorSpec:
     raise KeyError(f"no prior for parameter {name!r}")
 
 
-def priors_for(problem: Problem, priors: Mapping[str, PriorSpec]) -> dict[str, PriorSpec]:
-    """Prior of each identified parameter: from ``priors`` if given, else the library default."""
-    return {n: priors[n] if n in priors else default_prior(n) for n in problem.parameter_names}
+def priors_for(problem: Problem, priors: Mapping[str, PriorSpec],
+               names: Sequence[str] | None = None) -> dict[str, PriorSpec]:
+    """Prior of each identified parameter (or of ``names``): from ``priors`` if given, else
+    the library default."""
+    names = problem.parameter_names if names is None else names
+    return {n: priors[n] if n in priors else default_prior(n) for n in names}
 
 
 def build_model(problem: Problem, priors: Mapping[str, PriorSpec]) -> pm.Model:

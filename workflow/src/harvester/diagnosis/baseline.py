@@ -29,7 +29,7 @@ from scipy import optimize, signal
 
 from harvester.likelihood import Problem
 from harvester.priors import PriorSpec
-from harvester.pymc_models import default_prior
+from harvester.pymc_models import priors_for
 
 log = logging.getLogger("harvester.diagnosis")
 
@@ -138,7 +138,7 @@ class PointFit:
 
 def _prior_arrays(problem: Problem, priors: Mapping[str, PriorSpec]):
     names = problem.structure.free_parameters
-    specs = {n: priors[n] if n in priors else default_prior(n) for n in names}
+    specs = priors_for(problem, priors, names)
     mu = np.array([specs[n].mean for n in names])
     sd = np.array([specs[n].sd for n in names])
     lower = np.array([specs[n].lower for n in names])

@@ -42,7 +42,7 @@ from harvester.identify import TMCMCSettings, identify, posterior_theta
 from harvester.physics import term
 from harvester.posterior import pooled_log_evidence
 from harvester.priors import PriorSpec
-from harvester.pymc_models import default_prior
+from harvester.pymc_models import default_prior, priors_for
 from harvester.structures import ModelStructure
 from harvester.tmcmc import log_evidence
 
@@ -193,8 +193,7 @@ def fit_structure(problem: ChainProblem, structure: ModelStructure,
     ev = log_evidence(idata)
     log.info("%s: log evidence %s (pooled %.2f)", structure.name,
              ", ".join(f"{e:.2f}" for e in ev), pooled_log_evidence(ev))
-    names = p.parameter_names
-    used = {n: priors[n] if n in priors else default_prior(n) for n in names}
+    used = priors_for(p, priors)
     return ModelFit(structure, p, samples, ev, idata, used)
 
 
