@@ -24,11 +24,11 @@ def _truth(effect, ratio, seed, baseline="tanh"):
 
 def _diag(*missing):
     return {"verdict": "missing_physics" if missing else "adequate", "missing": list(missing),
-            "p_value": 0.01 if missing else 0.5}
+            "detection": {"p_value": 0.01 if missing else 0.5}}
 
 
 def _flagged_unnamed():
-    return {"verdict": "missing_physics", "missing": [], "p_value": 0.01}
+    return {"verdict": "missing_physics", "missing": [], "detection": {"p_value": 0.01}}
 
 
 @pytest.fixture
@@ -49,7 +49,8 @@ def results():
         # effect-free: 1 alarm in 4 (tanh), 0 in 2 (linear)
         (_truth("none_tanh", 0.0, 0), _diag()),
         (_truth("none_tanh", 0.0, 1), _diag("backlash")),
-        (_truth("none_tanh", 0.0, 2), _diag()),
+        # the screen fired, the evidence did not confirm anything
+        (_truth("none_tanh", 0.0, 2), {**_diag(), "detection": {"p_value": 0.02, "alpha": 0.05}}),
         (_truth("none_tanh", 0.0, 3), _diag()),
         (_truth("none_linear", 0.0, 0, "linear"), _diag()),
         (_truth("none_linear", 0.0, 1, "linear"), _diag()),
@@ -111,6 +112,7 @@ def test_confusion_matrix(results):
 def test_false_alarms(results):
     fa = det.false_alarms(results).set_index("baseline")
     assert (fa.loc["tanh", "scenarios"], fa.loc["tanh", "false_alarms"]) == (4, 1)
+    assert (fa.loc["tanh", "screen_alarms"], fa.loc["all", "screen_alarms"]) == (2, 2)
     assert fa.loc["linear", "rate"] == 0.0 and fa.loc["linear", "meets_goal"]
     assert fa.loc["all", "rate"] == pytest.approx(1 / 6)
     assert not fa.loc["all", "meets_goal"] and not fa.loc["all", "goal_certain"]
@@ -142,7 +144,7 @@ def _small_detection_config() -> dict:
     cfg["detection"]["grid"] = "small"
     cfg["detection"]["grids"]["small"].update(
         effects=["end_stop", "coulomb_friction"], ratios=[0.5], seeds=1,
-        effect_free=["none_tanh"], false_alarm_seeds=1, duration_s=6.0, fast=True)
+        effect_free=["none_tanh"], false_alarm_seeds=1, duration_s=8.0, fast=True)
     return cfg
 
 
@@ -207,7 +209,7 @@ def _job_resources(dry_run: str, rule: str) -> list[dict[str, str]]:
 
 @pytest.mark.slow
 def test_small_grid_runs_end_to_end(tmp_path):
-    """The local run: scenarios, diagnoses, tables, figure (about a minute on two cores)."""
+    """The local run: scenarios, diagnoses, tables, figure (several minutes on two cores)."""
     workdir, snakefile = _workdir(tmp_path, _small_detection_config())
     cmd = [str(SNAKEMAKE), "detection_all", "-s", str(snakefile), "-d", str(workdir),
            "--configfile", str(workdir / "config.yaml"), "--cores", "2", "--quiet", "rules"]
@@ -223,6 +225,7 @@ def test_small_grid_runs_end_to_end(tmp_path):
     assert (d / "figures/detection_rates.png").stat().st_size > 10_000
     res = pd.read_csv(d / "scenario_results.csv")
     assert np.allclose(res.loc[~res["effect_free"], "contribution_ratio"], 0.5, rtol=0.01)
+    assert res["p_value"].between(0.0, 1.0).all()
 
 
 def test_tied_counts_an_effect_reported_indistinguishable_from_the_first():

@@ -139,3 +139,14 @@ def test_linear_baseline_on_friction_data_names_friction_and_conflicts_with_prio
     shares = np.exp(det.window_stats.observed)
     assert shares.sum() == pytest.approx(1.0, rel=1e-6)
     assert det.band_energy.sum() > 0 and np.all(det.band_explained >= 0)
+
+
+def test_a_fast_sampled_recording_is_resampled_to_its_band_and_diagnosed_alike():
+    # the same concealed end stop recorded at 1024 Hz: simulated at 256 Hz, still found
+    settings = ScenarioSettings(duration_s=16.0, fs=1024.0, oversample=4)
+    sc = make_scenario("end_stop", 0.5, 11, settings, masking=False)
+    det, state = run_detection(sc.recording, seed=1)
+    assert state.problem.dt == pytest.approx(1.0 / 256.0)
+    assert det.significant, f"p = {det.p_value}"
+    top = [r.effect for r in rank(det, state, PRIORS)[:2]]
+    assert {"end_stop", "cubic_stiffness"} & set(top), top

@@ -111,3 +111,33 @@ def test_default_filters_the_output_only(two_tones: pd.DataFrame) -> None:
     out = filter_recording(two_tones, CUTOFF, ORDER)
     np.testing.assert_array_equal(out["base_acc"], two_tones["base_acc"])
     assert not np.allclose(out["rel_acc"], two_tones["rel_acc"])
+
+
+def test_decimation_factor_keeps_the_rate_per_cutoff():
+    from harvester.signals import decimation_factor
+    assert decimation_factor(1024.0, 20.0) == 4
+    assert decimation_factor(256.0, 20.0) == 1
+    assert decimation_factor(1000.0, 18.2) == 4      # 250 Hz >= 12.8 x 18.2 = 233 Hz
+    assert decimation_factor(5000.0, None) == 1      # unfiltered: the rate is kept
+
+
+def test_decimated_recording_keeps_the_band_and_its_time_base():
+    from harvester.signals import decimate_recording
+    fs, q = 1024.0, 4
+    t = np.arange(int(20 * fs)) / fs
+    rng = np.random.default_rng(3)
+    x = lowpass(rng.standard_normal(t.size), fs, CUTOFF, ORDER)
+    df = pd.DataFrame({"time": t, "base_acc": x, "rel_acc": 0.5 * x})
+    out = decimate_recording(df, q)
+    assert list(out.columns) == list(df.columns) and len(out) == t.size // q
+    np.testing.assert_allclose(np.diff(out["time"]), q / fs)
+    inner = slice(100, -100)   # beyond the FIR's end effects
+    err = out["base_acc"].to_numpy()[inner] - x[::q][inner]
+    assert np.sqrt(np.mean(err**2)) < 1e-6 * np.std(x)
+    np.testing.assert_allclose(out["rel_acc"], 0.5 * out["base_acc"], atol=1e-12)
+
+
+def test_sampling_rate_accepts_time_written_to_nine_decimals():
+    from harvester.signals import sampling_rate
+    t = np.round(np.arange(4096) / 1024.0, 9)      # 0.000976562, 0.001953125, ...
+    assert sampling_rate(pd.DataFrame({"time": t})) == pytest.approx(1024.0, rel=1e-9)

@@ -115,6 +115,8 @@ def score(truth: Mapping[str, Any], diagnosis: Mapping[str, Any],
     named = (missing[0] if missing else UNNAMED) if flagged else ADEQUATE
     ok = accepted_names(effect, accepted)
     effect_free = float(truth["ratio"]) == 0.0
+    screen = diagnosis.get("detection") or {}
+    p_value = float(screen.get("p_value", np.nan))
     return {
         "effect": effect, "ratio": float(truth["ratio"]), "seed": int(truth["seed"]),
         "baseline": truth.get("baseline", ""), "effect_free": effect_free,
@@ -126,7 +128,9 @@ def score(truth: Mapping[str, Any], diagnosis: Mapping[str, Any],
         "named": (not effect_free) and flagged and bool(missing) and missing[0] in ok,
         "tied": (not effect_free) and flagged and bool(ok & _first_group(diagnosis, missing)),
         "top2": (not effect_free) and flagged and bool(ok & set(missing[:2])),
-        "p_value": float(diagnosis.get("p_value", np.nan)),
+        "p_value": p_value,
+        # the detection screen alone (before any evidence), at its own alpha
+        "screen_flagged": bool(p_value < float(screen.get("alpha", 0.05))),
         "runtime_s": float(diagnosis.get("runtime_s", np.nan)),
     }
 
@@ -201,7 +205,11 @@ def confusion_matrix(results: pd.DataFrame) -> pd.DataFrame:
 
 
 def false_alarms(results: pd.DataFrame, goal: float = GOAL_FALSE_ALARM_RATE) -> pd.DataFrame:
-    """False-alarm rate on the effect-free scenarios, per baseline and overall (Wilson 95 %)."""
+    """False-alarm rate on the effect-free scenarios, per baseline and overall (Wilson 95 %).
+
+    ``false_alarms`` counts verdicts of missing physics; ``screen_alarms`` the recordings on
+    which the detection screen alone (before the evidence) fired.
+    """
     free = results[results["effect_free"]]
     rows = []
     groups = [(b, g) for b, g in free.groupby("baseline", sort=True)] + [("all", free)]
@@ -210,6 +218,7 @@ def false_alarms(results: pd.DataFrame, goal: float = GOAL_FALSE_ALARM_RATE) -> 
         k = int(g["flagged"].sum())
         lo, hi = wilson_interval(k, n)
         rows.append({"baseline": baseline, "scenarios": n, "false_alarms": k,
+                     "screen_alarms": int(g["screen_flagged"].sum()),
                      "rate": k / n if n else np.nan, "rate_lo": float(lo), "rate_hi": float(hi),
                      "meets_goal": bool(n and k / n <= goal),
                      "goal_certain": bool(n and float(hi) <= goal),

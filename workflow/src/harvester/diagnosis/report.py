@@ -203,7 +203,8 @@ def _diagnosis_dict(d) -> dict:
                     "accepted": rnd.accepted.effect if rnd.accepted else None}
                    for rnd in d.rounds],
         "measurement_chain": {"lowpass_hz": d.lowpass_hz, "filter_order": s.filter_order,
-                              "tempering_lambda": d.temper},
+                              "tempering_lambda": d.temper,
+                              "analysis_rate_hz": float(1.0 / (d.time[1] - d.time[0]))},
         "analysis_window_s": list(d.window_s),
         "tmcmc_window_s": list(d.fit_window_s),
         "priors": {k: {"mean": v.mean, "sd": v.sd, "lower": v.lower, "unit": v.unit}

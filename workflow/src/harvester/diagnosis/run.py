@@ -34,6 +34,7 @@ from harvester.identify import make_problem, posterior_theta
 from harvester.likelihood import Problem
 from harvester.posterior import parameter_names as idata_parameter_names
 from harvester.priors import PriorSpec
+from harvester.signals import decimate_recording, decimation_factor
 from harvester.structures import ModelStructure, structure as named_structure
 from harvester.tmcmc import log_evidence as idata_log_evidence
 
@@ -200,6 +201,28 @@ def check_recording(df: pd.DataFrame, source: str = "<recording>", lead_in_s: fl
     return out, dt
 
 
+def resample_for_model(rec: pd.DataFrame, validation: pd.DataFrame | None, dt: float,
+                       lowpass_hz: float | None
+                       ) -> tuple[pd.DataFrame, pd.DataFrame | None, float, list[str]]:
+    """(recording, validation, dt, notes) at the rate the model is simulated: a recording
+    low-passed at ``lowpass_hz`` and sampled faster than ``signals.RATE_PER_CUTOFF`` x that
+    is decimated (``signals.decimate_recording``; 1024 Hz with a 20 Hz filter -> 256 Hz).
+    The validation record, at the same rate, is decimated alike."""
+    q = decimation_factor(1.0 / dt, lowpass_hz)
+    if q == 1:
+        return rec, validation, dt, []
+    if validation is not None:
+        dt_v = float(np.median(np.diff(validation["time"].to_numpy(dtype=float))))
+        if abs(dt_v - dt) > 1e-6 * dt:
+            raise DataError("<validation>", f"sampled every {dt_v:.9g} s, the recording every "
+                            f"{dt:.9g} s: give both at the same rate", column="time")
+        validation = decimate_recording(validation, q)
+    note = (f"recording resampled from {1.0 / dt:.0f} Hz to {1.0 / (q * dt):.0f} Hz "
+            f"(low-pass at {lowpass_hz:.1f} Hz)")
+    log.info(note)
+    return decimate_recording(rec, q), validation, q * dt, [note]
+
+
 def _posterior_samples(idata: az.InferenceData, names: tuple[str, ...]) -> np.ndarray:
     stored = idata_parameter_names(idata)
     if list(stored) != list(names):
@@ -274,6 +297,8 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
     if validation is not None:
         validation, _ = check_recording(validation, "<validation>", settings.lead_in_s, 0.0)
     base = named_structure(baseline) if isinstance(baseline, str) else baseline
+    lowpass = settings.lowpass_hz or filter_cutoff(rec["rel_acc"].to_numpy(), 1.0 / dt)
+    rec, validation, dt, notes = resample_for_model(rec, validation, dt, lowpass)
     fs = 1.0 / dt
     n = len(rec)
     lead = int(round(settings.lead_in_s * fs))
@@ -284,7 +309,6 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
         lead + int(round((end - lead) * (1.0 - settings.holdout_fraction)))
     fit_stop = min(hold, lead + int(round(settings.fit_seconds * fs)))
     t = rec["time"].to_numpy()
-    lowpass = settings.lowpass_hz or filter_cutoff(rec["rel_acc"].to_numpy(), fs)
     order = settings.filter_order
     f_high = 0.9 * (lowpass or 0.5 * fs)
     log.info("recording %s: %.1f s at %.0f Hz; low-pass %s; analysed %.1f-%.1f s, TMCMC on "
@@ -295,7 +319,6 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
     raw_det = make_problem(rec, base, known, window=(lead, hold))
     raw_fit = make_problem(rec, base, known, window=(lead, fit_stop))
     cs = settings.confirmation()
-    notes: list[str] = []
 
     # ---- the baseline's posterior and the tempering lambda
     baseline_fit: ModelFit | None = None
@@ -442,9 +465,10 @@ def quick_detect(recording: pd.DataFrame, baseline: str | ModelStructure,
     recordings. The whole recording after the lead-in is analysed (nothing held out)."""
     rec, dt = check_recording(recording, "<recording>", settings.lead_in_s, 0.0)
     base = named_structure(baseline) if isinstance(baseline, str) else baseline
+    lowpass = settings.lowpass_hz or filter_cutoff(rec["rel_acc"].to_numpy(), 1.0 / dt)
+    rec, _, dt, _ = resample_for_model(rec, None, dt, lowpass)
     fs = 1.0 / dt
     lead = int(round(settings.lead_in_s * fs))
-    lowpass = settings.lowpass_hz or filter_cutoff(rec["rel_acc"].to_numpy(), fs)
     raw = make_problem(rec, base, known, window=(lead, len(rec)))
     if temper is None:
         mp = fit_map(chain_problem(raw, 1.0, lowpass, settings.filter_order), priors or {},
