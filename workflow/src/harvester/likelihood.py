@@ -49,6 +49,7 @@ class Problem:
     stride: int = 1  # the likelihood uses every stride-th sample of the window
     temper: float = 1.0  # power of the likelihood: eq. (10) x temper (1 / tau for correlated noise)
     v_bound: float | None = None  # largest velocity (m/s) for the sub-step choice (simulate)
+    oversample: int = 1  # simulate at this x the rate and anti-alias z'' (simulate, a DAQ's view)
     n_evaluations: int = field(default=0, init=False)
 
     def __post_init__(self) -> None:
@@ -133,7 +134,8 @@ class Problem:
         u = self.input if input is None and base_acc is None else (
             input if input is not None else base_acc)
         return simulate(self.structure.layout, self.layout_params(theta), u, self.dt,
-                        force_input=self.input_kind == "force", v_bound=self.v_bound)
+                        force_input=self.input_kind == "force", v_bound=self.v_bound,
+                        oversample=self.oversample)
 
     def output_of(self, sim: Simulation) -> np.ndarray:
         """The simulated output of this problem's kind (particles, samples), NaN where failed."""

@@ -49,7 +49,8 @@ def unseen_fit(problem: ChainProblem, samples: np.ndarray, base_acc: np.ndarray,
     theta = thin(samples, count, seed)
     record = ChainProblem(problem.structure, base_acc, rel_acc, problem.dt, dict(problem.known),
                           (section[0], section[1]), temper=problem.temper,
-                          lowpass_hz=problem.lowpass_hz, filter_order=problem.filter_order)
+                          lowpass_hz=problem.lowpass_hz, filter_order=problem.filter_order,
+                          oversample=problem.oversample)
     pred, ok = record.predicted(theta)
     if not ok.any():
         raise RuntimeError(f"no posterior sample of {problem.structure.name} can be simulated")

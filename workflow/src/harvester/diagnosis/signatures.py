@@ -162,7 +162,8 @@ def signatures(state: BaselineState, scale: MotionScale,
                 ref = len(rows)
                 rows.append(np.concatenate([base_params, [off[p.name] for p in t.parameters]]))
             meta.append((shape, amount, ref))
-        sim = simulate(layout, np.array(rows), problem.base_acc, problem.dt)
+        sim = simulate(layout, np.array(rows), problem.base_acc, problem.dt,
+                       oversample=problem.oversample)
         i = 0
         for shape, amount, ref in meta:
             reference = state.rel_acc if ref is None else sim.rel_acc[ref]  # through the chain

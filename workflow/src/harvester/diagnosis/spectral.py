@@ -26,6 +26,13 @@ F_LOW_HZ = 0.1
 #: and the fewest DFT bins it spans (the estimate's scatter is about 1.25 / sqrt(bins)).
 SMOOTHING_HZ = 1.0
 SMOOTHING_BINS = 41
+#: At low frequencies the running estimates narrow to SMOOTHING_Q x f (never below
+#: MIN_SMOOTHING_BINS bins): the noise floor changes fastest there. Base-sensor noise passes
+#: into the residual in full below the resonance and only in part above it, and a median over
+#: 1-2 Hz had put the floor at 0.1-0.2 Hz ninefold too low (measured on a linear device),
+#: which made low-frequency signatures (an offset force) look significant.
+SMOOTHING_Q = 0.5
+MIN_SMOOTHING_BINS = 5
 #: Local slope (dB per octave) beyond which a roll-off is taken for an anti-alias or
 #: preprocessing low-pass rather than mechanics.
 STEEP_DB_PER_OCTAVE = 40.0
@@ -120,18 +127,37 @@ class Frame:
         whose median is ln 2 x mean.
         """
         p = np.abs(X) ** 2
-        size = (1,) * (p.ndim - 1) + (self.smoothing_bins,)
-        s = ndimage.median_filter(p, size=size, mode="nearest") / np.log(2.0)
+        s = self._running(p, lambda x, w: ndimage.median_filter(
+            x, size=(1,) * (x.ndim - 1) + (w,), mode="nearest")) / np.log(2.0)
         floor = 1e-12 * max(float(np.max(s)), 1e-300)
         return np.maximum(s, floor)
 
     @property
     def smoothing_bins(self) -> int:
+        """Bins of the running estimates away from the lowest frequencies."""
         return max(SMOOTHING_BINS, int(round(SMOOTHING_HZ * self.n / self.fs)) | 1)
 
+    @property
+    def bin_widths(self) -> np.ndarray:
+        """Odd number of bins of the running estimates at each bin: ``smoothing_bins``,
+        narrowed to SMOOTHING_Q x f at low frequencies (at least MIN_SMOOTHING_BINS)."""
+        df = self.fs / self.n
+        w = np.round(SMOOTHING_Q * self.freqs / df).astype(int) | 1
+        return np.clip(w, MIN_SMOOTHING_BINS, self.smoothing_bins)
+
+    def _running(self, p: np.ndarray, smooth) -> np.ndarray:
+        """``smooth(p, width)`` along the last axis with each bin's own width."""
+        widths = self.bin_widths
+        out = np.empty(p.shape, dtype=float)
+        for w in np.unique(widths):
+            sel = widths == w
+            out[..., sel] = smooth(p, int(w))[..., sel]
+        return out
+
     def smoothed_mean(self, p: np.ndarray) -> np.ndarray:
-        """Running mean of a spectrum over SMOOTHING_HZ."""
-        return ndimage.uniform_filter1d(p, self.smoothing_bins, mode="nearest")
+        """Running mean of a spectrum over SMOOTHING_HZ (narrower at low frequencies)."""
+        return self._running(np.asarray(p, dtype=float), lambda x, w: ndimage.uniform_filter1d(
+            x, w, axis=-1, mode="nearest"))
 
 
 @dataclass
@@ -194,11 +220,9 @@ def noise_replicates(spectrum: np.ndarray, frame: Frame, count: int,
     n = frame.n
     level = spectrum / np.mean(frame.taper**2)
     # the spectrum is itself an estimate: each replicate draws its own, scattered about it
-    # as a running median of SMOOTHING_BINS periodogram ordinates scatters (~1.25/sqrt(bins))
-    width = frame.smoothing_bins
-    scatter = 1.25 * ndimage.uniform_filter1d(rng.standard_normal((count, level.size)), width,
-                                              axis=-1, mode="nearest")
-    level = level * np.exp(scatter - 0.5 * np.var(scatter))
+    # as a running median of the frame's bin widths scatters (~1.25/sqrt(bins))
+    scatter = 1.25 * frame.smoothed_mean(rng.standard_normal((count, level.size)))
+    level = level * np.exp(scatter - 0.5 * np.var(scatter, axis=0))
     white = np.fft.rfft(rng.standard_normal((count, n)), axis=-1)
     series = np.fft.irfft(white * np.sqrt(level / n), n=n, axis=-1)
     if envelope is not None:
