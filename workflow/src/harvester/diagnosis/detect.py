@@ -16,7 +16,7 @@ candidate effect (``signatures.py``), z = <g_perp, r> / sd with sd from the repl
 one-sided for effects whose strength cannot be negative; an effect's statistic is the largest
 z^2 over its shape grid and the family's the largest over effects; its p-value is the share of
 replicates whose largest statistic is at least as large. False alarms on recordings of the
-baseline itself: 2 of 60 at alpha = 0.05 (tests/test_diagnosis_calibration.py).
+baseline itself stay at most alpha = 0.05 over 60 seeds (tests/test_diagnosis_calibration.py).
 
 Locations (``locate.py``): shares of residual energy in time windows and state regions against
 stationary replicates, and per frequency band the share the signatures explain. They say
