@@ -10,6 +10,8 @@ the filter cancels from the frequency response z''/y'' and introduces no delay b
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
@@ -61,19 +63,27 @@ def filter_response_db(freqs: ArrayLike, fs: float, cutoff_hz: float,
     return 20.0 * np.log10(np.maximum(np.abs(h) ** 2, 1e-300))
 
 
+def uniform_step(t: ArrayLike, source: str | Path = "<recording>") -> float:
+    """Median step (s) of a time column; DataError naming the first row (1 = header) whose
+    step differs by more than 1e-6 of it plus 1 ns (times written to 9 decimals pass)."""
+    steps = np.diff(np.asarray(t, dtype=float))
+    if steps.size < 1 or np.any(steps <= 0.0):
+        raise DataError(source, "time must increase, with at least two samples", column="time")
+    step = float(np.median(steps))
+    bad = np.flatnonzero(np.abs(steps - step) > 1e-6 * step + 1e-9)
+    if bad.size:
+        raise DataError(source, f"non-uniform time base at row {int(bad[0]) + 2}: step "
+                        f"{steps[bad[0]]:.9g} s, expected {step:.9g} s", column="time")
+    return step
+
+
 def sampling_rate(df: pd.DataFrame, source: str = "<recording>") -> float:
     """Sampling rate (Hz) of a converted recording, checking its time column is uniform."""
     if "time" not in df.columns:
         raise DataError(source, "no time column", column="time")
-    dt = np.diff(df["time"].to_numpy(dtype=float))
-    if dt.size == 0 or np.any(dt <= 0.0):
-        raise DataError(source, "time must increase, with at least two samples", column="time")
-    step = float(np.median(dt))
-    bad = np.flatnonzero(np.abs(dt - step) > 1e-6 * step + 1e-9)  # as written to 9 decimals
-    if bad.size:
-        raise DataError(source, f"time is not uniformly sampled: step {dt[bad[0]]:.9g} s at "
-                        f"row {int(bad[0]) + 2}, expected {step:.9g} s", column="time")
-    return float(1.0 / dt.mean())
+    t = df["time"].to_numpy(dtype=float)
+    uniform_step(t, source)
+    return float((t.size - 1) / (t[-1] - t[0]))
 
 
 def filter_recording(df: pd.DataFrame, cutoff: float, order: int,
@@ -113,22 +123,30 @@ def decimation_factor(fs: float, cutoff_hz: float | None,
     return max(1, int(np.floor(fs / (rate_per_cutoff * cutoff_hz) + 1e-9)))
 
 
-def decimate_recording(df: pd.DataFrame, q: int, order: int = 8) -> pd.DataFrame:
-    """Every q-th sample of a recording: time, and each other column after a zero-phase
-    Butterworth anti-alias low-pass (``order``) at 0.8 x the new Nyquist frequency.
+#: Anti-alias low-pass before keeping every q-th sample: zero-phase Butterworth of this order
+#: at this fraction of the new Nyquist frequency (gain 1 - 1e-10 below 0.2 x that frequency).
+ANTIALIAS_ORDER = 8
+ANTIALIAS_FRACTION = 0.8
 
-    Every channel gets the same linear filter, so an input-output relation in the retained
-    band is kept; its gain there is 1 to 1e-10 when the band ends below 0.2 x the new
-    Nyquist frequency (``RATE_PER_CUTOFF`` >= 10).
-    """
+
+def antialias_decimate(x: ArrayLike, fs: float, q: int) -> NDArray[np.float64]:
+    """Every q-th sample along the last axis after the anti-alias low-pass (ANTIALIAS_*), as a
+    data acquisition samples a faster signal."""
+    x = np.asarray(x, dtype=float)
+    if q == 1:
+        return x.copy()
+    return lowpass(x, fs, ANTIALIAS_FRACTION * fs / (2.0 * q), ANTIALIAS_ORDER)[..., ::q]
+
+
+def decimate_recording(df: pd.DataFrame, q: int) -> pd.DataFrame:
+    """Every q-th sample of a recording: time, and each other column through
+    :func:`antialias_decimate`. Every channel gets the same linear filter, so an
+    input-output relation in the retained band is kept."""
     if q < 1:
         raise ValueError(f"decimation factor must be >= 1, got {q}")
-    if q == 1:
-        return df.copy()
     t = df["time"].to_numpy(dtype=float)
     fs = 1.0 / float(np.median(np.diff(t)))
-    cutoff = 0.8 * fs / (2.0 * q)
-    out = {c: (t if c == "time" else lowpass(df[c].to_numpy(dtype=float), fs, cutoff, order))[::q]
+    out = {c: t[::q] if c == "time" else antialias_decimate(df[c].to_numpy(dtype=float), fs, q)
            for c in df.columns}
     return pd.DataFrame(out, columns=list(df.columns))
 

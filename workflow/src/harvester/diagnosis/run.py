@@ -34,7 +34,7 @@ from harvester.identify import make_problem, posterior_theta
 from harvester.likelihood import Problem
 from harvester.posterior import parameter_names as idata_parameter_names
 from harvester.priors import PriorSpec
-from harvester.signals import decimate_recording, decimation_factor
+from harvester.signals import decimate_recording, decimation_factor, uniform_step
 from harvester.structures import ModelStructure, structure as named_structure
 from harvester.tmcmc import log_evidence as idata_log_evidence
 
@@ -183,14 +183,7 @@ def check_recording(df: pd.DataFrame, source: str = "<recording>", lead_in_s: fl
         if bad.size:
             raise DataError(source, f"not a finite number at row {int(bad[0]) + 1}", column=c)
     t = df["time"].to_numpy(dtype=float)
-    steps = np.diff(t)
-    if steps.size < 2 or np.median(steps) <= 0:
-        raise DataError(source, "time must increase", column="time")
-    dt = float(np.median(steps))
-    bad = np.flatnonzero(np.abs(steps - dt) > 1e-6 * dt + 1e-9)
-    if bad.size:
-        raise DataError(source, f"non-uniform time base at row {int(bad[0]) + 2}: step "
-                        f"{steps[bad[0]]:.9g} s, expected {dt:.9g} s", column="time")
+    dt = uniform_step(t, source)
     need = lead_in_s + MIN_ANALYSIS_S / (1.0 - holdout_fraction) + 0.5
     if t[-1] - t[0] + dt < need - 1e-9:
         held = f", {holdout_fraction:.0%} held out" if holdout_fraction > 0 else ""
@@ -212,7 +205,7 @@ def resample_for_model(rec: pd.DataFrame, validation: pd.DataFrame | None, dt: f
     if q == 1:
         return rec, validation, dt, []
     if validation is not None:
-        dt_v = float(np.median(np.diff(validation["time"].to_numpy(dtype=float))))
+        dt_v = uniform_step(validation["time"].to_numpy(dtype=float), "<validation>")
         if abs(dt_v - dt) > 1e-6 * dt:
             raise DataError("<validation>", f"sampled every {dt_v:.9g} s, the recording every "
                             f"{dt:.9g} s: give both at the same rate", column="time")
