@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from harvester.diagnosis import DiagnosisSettings, quick_detect
-from harvester.diagnosis.baseline import CHAIN_OVERSAMPLE, ChainProblem, chain_problem
+from harvester.diagnosis.baseline import ChainProblem, chain_problem
+from harvester.likelihood import DAQ_OVERSAMPLE
 from harvester.diagnosis.detect import estimate_temper
 from harvester.diagnosis.rank import rank
 from harvester.diagnosis.spectral import filter_cutoff
@@ -59,8 +60,8 @@ def test_chain_problem_without_chain_is_eq10_and_tempering_scales_it():
     plain = make_problem(df, "tanh", TABLE1_KNOWN, window=(256, 1200))
     theta = np.array([[109.5, 11.86, 88.35, 0.05], [150.0, 9.0, 60.0, 0.08]])
     chained = chain_problem(plain, 1.0, None)
-    assert chained.oversample == CHAIN_OVERSAMPLE > 1   # the chain samples z'' as a DAQ does
-    plain = plain.replace(oversample=CHAIN_OVERSAMPLE)
+    assert chained.oversample == DAQ_OVERSAMPLE > 1   # the chain samples z'' as a DAQ does
+    plain = plain.replace(oversample=DAQ_OVERSAMPLE)
     np.testing.assert_allclose(chained.loglike(theta), plain.loglike(theta), rtol=1e-10)
     half = chain_problem(plain, 0.5, None)
     np.testing.assert_allclose(half.loglike(theta), 0.5 * plain.loglike(theta), rtol=1e-10)

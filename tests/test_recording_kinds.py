@@ -131,7 +131,7 @@ def test_base_input_in_g_gives_an_impossible_mass_ratio() -> None:
 def test_make_problem_picks_up_the_kinds(inp, out) -> None:
     df = synthetic(inp, out, n=400)
     known = {"m": TRUTH["m"]} if inp == "base_acc" else {}
-    p = make_problem(df, "linear+coulomb_friction", known)
+    p = make_problem(df, "linear+coulomb_friction", known, oversample=1)  # as `synthetic` samples
     assert (p.input_kind, p.output_kind) == (inp, out)
     expected = ("M", "k", "c_m") if inp == "base_acc" else ("M", "k", "c_m")
     assert p.structure.free_base == expected

@@ -10,7 +10,8 @@ import pytest
 import yaml
 
 from harvester.errors import DataError
-from harvester.signals import CHANNELS, filter_recording, filter_response_db, frf_h1, lowpass, psd
+from harvester.signals import (CHANNELS, filter_recording, filter_response_db, frf_h1, lowpass,
+                               psd, uniform_step)
 
 CONFIG = yaml.safe_load((Path(__file__).parents[1] / "config" / "config.yaml").read_text())
 FS = float(CONFIG["rig"]["daq"]["sampling_rate_hz"])
@@ -141,3 +142,16 @@ def test_sampling_rate_accepts_time_written_to_nine_decimals():
     from harvester.signals import sampling_rate
     t = np.round(np.arange(4096) / 1024.0, 9)      # 0.000976562, 0.001953125, ...
     assert sampling_rate(pd.DataFrame({"time": t})) == pytest.approx(1024.0, rel=1e-9)
+
+
+@pytest.mark.parametrize("fmt", ["%.9g", "%.6f"])
+def test_times_written_with_few_digits_are_uniform(fmt: str) -> None:
+    fs = 1024.0
+    t = np.array([float(fmt % x) for x in np.arange(40 * 1024) / fs])
+    assert uniform_step(t) == pytest.approx(1.0 / fs, rel=1e-7)
+
+
+def test_a_dropped_sample_is_named_by_row() -> None:
+    t = np.delete(np.arange(2000) / 256.0, 700)
+    with pytest.raises(DataError, match="row 702"):
+        uniform_step(t, "x.csv")

@@ -28,6 +28,8 @@ STUDY_PRIORS = {"c_m": (170.0, 50.0, "N s/m"), "F_c": (8.4, 5.0, "N"),
                 "beta": (100.0, 100.0, "s/m"), "sigma": (0.07, 0.03, "m/s^2")}
 TABLE1_F_C = 8.4
 DAMPING_FIT_BAND_HZ = (0.3, 10.0)
+#: c_m below this share of the purely viscous fit counts as driven to zero by the friction.
+AT_ZERO = 0.05
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -97,16 +99,31 @@ def _metadata(recording: Path) -> dict:
 
 
 def _priors(df, known: dict, given: dict, baseline: str) -> dict:
+    """Priors of the diagnosis: the study's (Table 4), with c_m's mean from the recording's
+    FRF (``initial.fit_viscous_damping``) given the static friction F_c (the yaml's
+    ``priors.F_c.mean``, else Table 1's). Where that friction alone over-explains the
+    recording's damping (c_m at zero), c_m is only known to lie between 0 and the purely
+    viscous fit, and its prior spans that range; then priors given in the yaml."""
     from harvester.initial import fit_viscous_damping
     from harvester.priors import PriorSpec
     from harvester.pymc_models import default_prior
     specs = {n: PriorSpec(n, m, s, u) for n, (m, s, u) in STUDY_PRIORS.items()}
+    f_c = float(given.get("F_c", {}).get("mean", TABLE1_F_C))
     try:
-        damping = fit_viscous_damping(df, known["M"], known["m"], known["k"], TABLE1_F_C,
-                                      DAMPING_FIT_BAND_HZ, lead_in=min(256, len(df) // 4))
-        specs["c_m"] = PriorSpec("c_m", float(damping.c_m), 50.0, "N s/m")
+        def fit(friction: float) -> float:
+            return float(fit_viscous_damping(df, known["M"], known["m"], known["k"], friction,
+                                             DAMPING_FIT_BAND_HZ,
+                                             lead_in=min(256, len(df) // 4)).c_m)
+        c_m, sd = fit(f_c), STUDY_PRIORS["c_m"][1]
         log.info("initial modelling: c_m = %.1f N s/m from the recording's FRF (Coulomb "
-                 "friction %.1f N)", damping.c_m, TABLE1_F_C)
+                 "friction %.1f N)", c_m, f_c)
+        viscous = fit(0.0) if f_c > 0 else c_m
+        if c_m < AT_ZERO * viscous:
+            c_m, sd = 0.0, max(sd, viscous)
+            log.warning("a friction of %.1f N alone gives more damping than the recording "
+                        "shows (purely viscous fit: c_m = %.1f N s/m); c_m prior 0 +- %.1f "
+                        "N s/m", f_c, viscous, sd)
+        specs["c_m"] = PriorSpec("c_m", c_m, sd, "N s/m")
     except Exception as err:  # noqa: BLE001 - fall back to Table 1
         log.warning("FRF damping fit failed (%s); c_m prior centred on Table 1's 170 N s/m", err)
     for name, spec in given.items():

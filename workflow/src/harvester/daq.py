@@ -39,6 +39,7 @@ import pandas as pd
 from harvester.errors import DataError
 from harvester.fileio import atomic_path
 from harvester.recording import check_plausible, recording_kinds
+from harvester.signals import time_base
 
 #: Standard gravity (m/s^2) used to convert g to m/s^2.
 G = 9.80665
@@ -225,23 +226,13 @@ def _decimals(cells: Iterable[str]) -> int | None:
 
 def _time_step(path: Path, t: np.ndarray, lines: list[int],
                decimals: int | None) -> tuple[float, float]:
-    """Median time step and its tolerance (s); DataError at the first non-uniform step.
-
-    The tolerance is TIME_REL_TOL of the step plus one unit of the last decimal written.
-    """
-    steps = np.diff(t)
-    if steps.size == 0:
-        raise DataError(path, "fewer than 2 samples: no time step", column="time")
-    dt = float(np.median(steps))
-    if dt <= 0.0:
-        raise DataError(path, "time does not increase", line=lines[1], column="time")
-    tol = TIME_REL_TOL * dt + (10.0 ** -decimals if decimals is not None else 0.0)
-    bad = np.flatnonzero(np.abs(steps - dt) > tol)
-    if bad.size:
-        i = int(bad[0])
-        raise DataError(path, f"non-uniform time base: step {steps[i]:.9g} s, expected "
-                        f"{dt:.9g} s", line=lines[i + 1], column="time")
-    return dt, tol
+    """Mean time step and its tolerance (s); DataError at the first sample off a uniform time
+    base (``signals.time_base``). The tolerance is TIME_REL_TOL of the step plus one unit of
+    the last decimal written (for the check against the metadata's sampling rate)."""
+    dt, bad, why = time_base(t)
+    if bad is not None:
+        raise DataError(path, why, line=lines[bad], column="time")
+    return dt, TIME_REL_TOL * dt + (10.0 ** -decimals if decimals is not None else 0.0)
 
 
 def _uniform_time(path: Path, df: pd.DataFrame, header: list[str], rows: list[list[str]],
@@ -384,8 +375,7 @@ def read_recording(path: str | Path) -> pd.DataFrame:
 
     Input ``base_acc`` (m/s^2) or ``force`` (N); output ``rel_acc`` (m/s^2) or ``rel_disp`` (m)
     (``harvester.recording.recording_kinds`` tells which from the columns). Every column must
-    be numeric with no NaN or empty rows, the time base uniform (relative tolerance 1e-6 plus
-    the rounding of the written decimals), there must be at least 64 samples, and a column
+    be numeric with no NaN or empty rows, the time base uniform (``signals.time_base``), there must be at least 64 samples, and a column
     in another unit (a header ``rel_disp_mm``, an acceleration with gravity left in, a
     displacement in mm) is reported (``harvester.recording.check_plausible``).
     """

@@ -10,7 +10,7 @@ import arviz as az
 import numpy as np
 import pandas as pd
 
-from harvester.likelihood import Problem
+from harvester.likelihood import DAQ_OVERSAMPLE, Problem
 from harvester.physics import BASE_PARAMETERS
 from harvester.priors import PriorSpec
 from harvester.recording import input_output
@@ -69,7 +69,8 @@ def check_identifiable(free_base: tuple[str, ...], input_kind: str) -> None:
 
 def make_problem(recording: pd.DataFrame, model: str | ModelStructure, known: Mapping[str, float],
                  window: tuple[int, int] | None = None, stride: int = 1,
-                 output_filter: tuple[float, int] | None = None) -> Problem:
+                 output_filter: tuple[float, int] | None = None,
+                 oversample: int = DAQ_OVERSAMPLE) -> Problem:
     """The identification problem for a recording (columns time, an input, an output).
 
     The recording's columns declare the kinds (``harvester.recording``): input ``base_acc``
@@ -78,7 +79,8 @@ def make_problem(recording: pd.DataFrame, model: str | ModelStructure, known: Ma
     ``harvester.frf_priors.initial_priors``. For a force input a missing m is set to 0
     (it does not enter eq. 1). ``stride``: the likelihood uses every stride-th sample.
     ``output_filter`` (cut-off Hz, order): the zero-phase low-pass the recording went through,
-    applied to the simulated output too.
+    applied to the simulated output too. ``oversample``: the model's z'' is sampled as a data
+    acquisition does (:data:`harvester.likelihood.DAQ_OVERSAMPLE`; 1: point samples).
     """
     s = structure(model) if isinstance(model, str) else model
     kinds, u, y, dt = input_output(recording)
@@ -90,7 +92,8 @@ def make_problem(recording: pd.DataFrame, model: str | ModelStructure, known: Ma
     if "m" not in free and "m" not in known:
         known["m"] = 0.0
     return Problem(s, u, y, dt, known, window, input_kind=kinds.input_kind,
-                   output_kind=kinds.output_kind, stride=stride, output_filter=output_filter)
+                   output_kind=kinds.output_kind, stride=stride, output_filter=output_filter,
+                   oversample=oversample)
 
 
 def identify(problem: Problem, priors: Mapping[str, PriorSpec],

@@ -27,6 +27,13 @@ from harvester.simulate import Simulation, simulate
 from harvester.structures import ModelStructure
 
 
+#: The acquisition's view of the model: z'' simulated at this x the record's rate, low-passed
+#: and taken at every 4th sample (``simulate``'s ``oversample``), as a data acquisition with an
+#: anti-alias filter samples it. Point samples fold friction harmonics above the Nyquist
+#: frequency into the band: about 0.1 x the noise RMS on the study's tanh device.
+DAQ_OVERSAMPLE = 4
+
+
 @dataclass
 class Problem:
     """What the sampler needs: theta = (free parameters..., sigma) -> log-likelihood.

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import optimize, signal
 
-from harvester.likelihood import Problem
+from harvester.likelihood import DAQ_OVERSAMPLE, Problem
 from harvester.priors import PriorSpec
 from harvester.pymc_models import priors_for
 
@@ -95,9 +95,6 @@ class ChainProblem(Problem):
 #: Samples simulated beyond the window's end so that the zero-phase filter's end effect
 #: falls outside the window.
 CHAIN_PAD_S = 0.5
-#: The chain's model of the acquisition: z'' simulated at this x the record's rate and
-#: anti-aliased (``simulate``), as a DAQ samples it; point samples alias friction harmonics.
-CHAIN_OVERSAMPLE = 4
 
 
 def chain_problem(problem: Problem, temper: float = 1.0, lowpass_hz: float | None = None,
@@ -111,7 +108,7 @@ def chain_problem(problem: Problem, temper: float = 1.0, lowpass_hz: float | Non
     return ChainProblem(structure or problem.structure, problem.base_acc[:end],
                         problem.rel_acc[:end], problem.dt, dict(problem.known), (start, stop),
                         temper=float(temper), v_bound=problem.v_bound, lowpass_hz=lowpass_hz,
-                        filter_order=filter_order, oversample=CHAIN_OVERSAMPLE)
+                        filter_order=filter_order, oversample=DAQ_OVERSAMPLE)
 
 
 # --------------------------------------------------------------------------- MAP fit

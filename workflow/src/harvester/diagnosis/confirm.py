@@ -16,7 +16,7 @@ Monte Carlo error) of the best accepted one are reported as indistinguishable on
 Priors of the added terms: the library's (``physics.py``), except where the library's default
 is set for the motion of the paper's rig rather than for any rig: the end stop's clearance and
 the cubic stiffness are scaled by the baseline's displacement, quadratic damping by its
-velocity, the secondary mode's frequency by the analysed band, and the pre-sliding
+velocity and c_m's prior scale (the larger of its mean and sd), the secondary mode's frequency by the analysed band, and the pre-sliding
 (hysteresis) force is kept above 0.2 N, below which the Dahl law is too stiff to integrate in
 minutes, and the bristle stiffness's prior (2 +- 2 kN/m, pre-sliding displacements of about
 0.1-10 mm at those forces) leaves out the stiff tail (k_hyst / F_hyst > 1e5 /m) that made one
@@ -154,7 +154,7 @@ class CandidateResult:
                 "added_parameters": {n: summ[n] for n in added if n in summ}}
 
 
-def candidate_priors(effect: str, scale: MotionScale, c_m_mean: float = 170.0
+def candidate_priors(effect: str, scale: MotionScale, c_m_scale: float = 170.0
                      ) -> dict[str, PriorSpec]:
     """Priors of an added term's parameters, scaled to the baseline's motion where the
     library's defaults only fit the paper's rig (see the module docstring)."""
@@ -165,7 +165,7 @@ def candidate_priors(effect: str, scale: MotionScale, c_m_mean: float = 170.0
     elif effect == "cubic_stiffness":
         out["k_cubic"] = PriorSpec("k_cubic", 0.0, 250.0 / scale.z**2, "N/m^3", -np.inf)
     elif effect == "quadratic_damping":
-        out["c_quad"] = PriorSpec("c_quad", 0.0, 0.5 * c_m_mean / scale.v, "N s^2/m^2", 0.0)
+        out["c_quad"] = PriorSpec("c_quad", 0.0, 0.5 * c_m_scale / scale.v, "N s^2/m^2", 0.0)
     elif effect == "unmodelled_mode":
         out["f_mode"] = PriorSpec("f_mode", 0.5 * scale.f_high, 0.35 * scale.f_high, "Hz", 0.5)
     elif effect == "hysteresis":
@@ -201,7 +201,8 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
             settings: ConfirmSettings, scale: MotionScale, seed_offset: int = 0
             ) -> list[CandidateResult]:
     """Sample each augmented structure; evidence against the baseline; acceptance."""
-    c_m = (priors.get("c_m") or default_prior("c_m")).mean
+    c_m_prior = priors.get("c_m") or default_prior("c_m")
+    c_m = max(c_m_prior.mean, c_m_prior.sd)  # the damping's scale, also when its mean is 0
     results = []
     for i, effect in enumerate(effects):
         structure = baseline.structure.with_term(effect)
