@@ -16,11 +16,13 @@ Monte Carlo error) of the best accepted one are reported as indistinguishable on
 Priors of the added terms: the library's (``physics.py``), except where the library's default
 is set for the motion of the paper's rig rather than for any rig: the end stop's clearance and
 the cubic stiffness are scaled by the baseline's displacement, quadratic damping by its
-velocity and c_m's prior scale (the larger of its mean and sd), the secondary mode's frequency by the analysed band, and the pre-sliding
-(hysteresis) force is kept above 0.2 N, below which the Dahl law is too stiff to integrate in
-minutes, and the bristle stiffness's prior (2 +- 2 kN/m, pre-sliding displacements of about
-0.1-10 mm at those forces) leaves out the stiff tail (k_hyst / F_hyst > 1e5 /m) that made one
-sampled candidate cost minutes in the grid. Priors given by the caller always win.
+velocity and c_m's prior scale (the larger of its mean and sd), the backlash's contact
+stiffness and the secondary mode's frequency by the analysed band
+(:func:`backlash_contact_prior`), and the pre-sliding (hysteresis) force is kept above 0.2 N,
+below which the Dahl law is too stiff to integrate in minutes, and the bristle stiffness's
+prior (2 +- 2 kN/m, pre-sliding displacements of about 0.1-10 mm at those forces) leaves out
+the stiff tail (k_hyst / F_hyst > 1e5 /m) that made one sampled candidate cost minutes in the
+grid. Priors given by the caller always win.
 
 Particles. A candidate's TMCMC gets ``particles`` x (its added parameters / 2), at least
 ``particles`` (``candidate_particles``): the secondary mode's four parameters hold a narrow
@@ -154,11 +156,36 @@ class CandidateResult:
                 "added_parameters": {n: summ[n] for n in added if n in summ}}
 
 
-def candidate_priors(effect: str, scale: MotionScale, c_m_scale: float = 170.0
-                     ) -> dict[str, PriorSpec]:
+#: The backlash candidate's contact resonance, sqrt(k_backlash / mu) / 2 pi with mu the reduced
+#: mass m J / (m + J), as multiples of the analysed band's upper edge: prior mean and lower bound.
+BACKLASH_CONTACT_BAND = (6.0, 4.0)
+
+
+def backlash_contact_prior(f_high: float, known: Mapping[str, float]) -> PriorSpec | None:
+    """Prior of k_backlash (N/m) whose contact resonance lies 4-6 x above the analysed band.
+
+    Above the band the recorded z'' cannot tell a stiffer contact from this one (the impact's
+    momentum, not its millisecond shape, shows below f_high), while the simulation's cost
+    grows as the resonance: a ball nut's 1e7-1e9 N/m costs 3-30 x more sub-steps for the same
+    evidence. None when M and m are not both known (M > m > 0).
+    """
+    M, m = float(known.get("M", 0.0)), float(known.get("m", 0.0))
+    if not M > m > 0.0:
+        return None
+    mu = m * (M - m) / M
+    k_mean, k_low = (mu * (2.0 * np.pi * r * f_high) ** 2 for r in BACKLASH_CONTACT_BAND)
+    return PriorSpec("k_backlash", k_mean, 0.5 * k_mean, "N/m", k_low)
+
+
+def candidate_priors(effect: str, scale: MotionScale, c_m_scale: float = 170.0,
+                     known: Mapping[str, float] | None = None) -> dict[str, PriorSpec]:
     """Priors of an added term's parameters, scaled to the baseline's motion where the
     library's defaults only fit the paper's rig (see the module docstring)."""
     out = {p.name: default_prior(p.name) for p in term(effect).parameters}
+    if effect == "backlash":
+        contact = backlash_contact_prior(scale.f_high, known or {})
+        if contact is not None:
+            out["k_backlash"] = contact
     if effect == "end_stop":
         gap = scale.z_quantiles[0.75]
         out["gap_stop"] = PriorSpec("gap_stop", gap, gap, "m", 0.0)
@@ -206,7 +233,7 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
     results = []
     for i, effect in enumerate(effects):
         structure = baseline.structure.with_term(effect)
-        specs = {**candidate_priors(effect, scale, c_m), **priors}
+        specs = {**candidate_priors(effect, scale, c_m, baseline.problem.known), **priors}
         run = replace(settings, particles=candidate_particles(effect, settings.particles))
         log.info("confirming %s (%d of %d, %d particles per chain)", structure.name, i + 1,
                  len(effects), run.particles)
