@@ -375,9 +375,10 @@ def read_recording(path: str | Path) -> pd.DataFrame:
 
     Input ``base_acc`` (m/s^2) or ``force`` (N); output ``rel_acc`` (m/s^2) or ``rel_disp`` (m)
     (``harvester.recording.recording_kinds`` tells which from the columns). Every column must
-    be numeric with no NaN or empty rows, the time base uniform (``signals.time_base``), there must be at least 64 samples, and a column
-    in another unit (a header ``rel_disp_mm``, an acceleration with gravity left in, a
-    displacement in mm) is reported (``harvester.recording.check_plausible``).
+    be numeric with no NaN or empty rows, the time base uniform (``signals.time_base``),
+    there must be at least 64 samples, and a column in another unit (a header ``rel_disp_mm``,
+    an acceleration with gravity left in, a displacement in mm) is reported
+    (``harvester.recording.check_plausible``).
     """
     path = Path(path)
     header, rows, lines = _read_rows(path)
