@@ -125,9 +125,11 @@ def test_c_m_prior_spans_the_damping_when_the_assumed_friction_over_explains_it(
     df, _ = measured_recording((), {**TABLE1_KNOWN, "c_m": 180.0}, 20.0, 3)
     specs = _priors(df, dict(TABLE1_KNOWN), {}, "linear")
     assert specs["c_m"].mean == 0.0 and 150.0 < specs["c_m"].sd < 210.0
-    # the friction the user measured in static tests is the one assumed
+    # a friction measured in static tests is taken as it is, as in the paper
     specs = _priors(df, dict(TABLE1_KNOWN), {"F_c": {"mean": 0.0, "sd": 1.0}}, "linear")
     assert specs["c_m"].mean == pytest.approx(180.0, rel=0.05) and specs["c_m"].sd == 50.0
+    specs = _priors(df, dict(TABLE1_KNOWN), {"F_c": {"mean": 8.4, "sd": 1.0}}, "linear")
+    assert specs["c_m"].mean < 9.0 and specs["c_m"].sd == 50.0
     # the quadratic-damping candidate's prior keeps a positive scale
     scale = MotionScale(z=0.01, v=0.05, z_quantiles={0.75: 0.01}, f_high=20.0)
     assert candidate_priors("quadratic_damping", scale, 50.0)["c_quad"].sd > 0.0

@@ -100,10 +100,11 @@ def _metadata(recording: Path) -> dict:
 
 def _priors(df, known: dict, given: dict, baseline: str) -> dict:
     """Priors of the diagnosis: the study's (Table 4), with c_m's mean from the recording's
-    FRF (``initial.fit_viscous_damping``) given the static friction F_c (the yaml's
-    ``priors.F_c.mean``, else Table 1's). Where that friction alone over-explains the
-    recording's damping (c_m at zero), c_m is only known to lie between 0 and the purely
-    viscous fit, and its prior spans that range; then priors given in the yaml."""
+    FRF (``initial.fit_viscous_damping``) given the static friction F_c: measured (the yaml's
+    ``priors.F_c.mean``), as in the paper's initial modelling, or assumed (Table 1's). Where an
+    assumed friction alone over-explains the recording's damping (c_m at zero), c_m is only
+    known to lie between 0 and the purely viscous fit and its prior spans that range: an
+    assumption must not make a prior conflict. Then the priors given in the yaml."""
     from harvester.initial import fit_viscous_damping
     from harvester.priors import PriorSpec
     from harvester.pymc_models import default_prior
@@ -117,7 +118,7 @@ def _priors(df, known: dict, given: dict, baseline: str) -> dict:
         c_m, sd = fit(f_c), STUDY_PRIORS["c_m"][1]
         log.info("initial modelling: c_m = %.1f N s/m from the recording's FRF (Coulomb "
                  "friction %.1f N)", c_m, f_c)
-        viscous = fit(0.0) if f_c > 0 else c_m
+        viscous = fit(0.0) if f_c > 0 and "F_c" not in given else c_m
         if c_m < AT_ZERO * viscous:
             c_m, sd = 0.0, max(sd, viscous)
             log.warning("a friction of %.1f N alone gives more damping than the recording "
