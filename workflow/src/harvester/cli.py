@@ -16,7 +16,6 @@ import logging
 import sys
 from pathlib import Path
 
-import numpy as np
 
 from harvester.errors import DataError
 
@@ -137,7 +136,7 @@ def _priors(df, known: dict, given: dict, baseline: str) -> dict:
 def diagnose_command(args: argparse.Namespace) -> int:
     from harvester.daq import read_recording
     from harvester.diagnosis import DiagnosisSettings, check_recording, diagnose
-    from harvester.signals import filter_recording
+    from harvester.signals import filter_recording, sampling_rate
 
     logging.getLogger("pymc").setLevel(logging.ERROR)  # pymc sets INFO when imported
     df = read_recording(args.recording)
@@ -145,7 +144,7 @@ def diagnose_command(args: argparse.Namespace) -> int:
     known = {k: float(meta.get(k, v)) for k, v in TABLE1_KNOWN.items()}
     lowpass = args.filtered_at or meta.get("filtered_at_hz")
     if args.lowpass is not None:
-        fs = 1.0 / float(np.median(np.diff(df["time"].to_numpy())))
+        fs = sampling_rate(df, str(args.recording))
         if not 0 < args.lowpass < fs / 2:
             raise DataError(args.recording, f"--lowpass {args.lowpass} Hz must lie in (0, "
                                             f"{fs / 2:g}) Hz")

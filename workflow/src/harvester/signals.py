@@ -171,7 +171,7 @@ def decimate_recording(df: pd.DataFrame, q: int) -> pd.DataFrame:
     if q < 1:
         raise ValueError(f"decimation factor must be >= 1, got {q}")
     t = df["time"].to_numpy(dtype=float)
-    fs = 1.0 / float(np.median(np.diff(t)))
+    fs = 1.0 / uniform_step(t)
     out = {c: t[::q] if c == "time" else antialias_decimate(df[c].to_numpy(dtype=float), fs, q)
            for c in df.columns}
     return pd.DataFrame(out, columns=list(df.columns))
