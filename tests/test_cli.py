@@ -8,11 +8,12 @@ import logging
 import numpy as np
 import pytest
 
-from harvester.cli import _priors, main
+from harvester.cli import main
 from harvester.daq import write_recording
 from harvester.diagnosis.confirm import candidate_priors
 from harvester.diagnosis.signatures import MotionScale
 from harvester.diagnosis.synthetic import TABLE1_KNOWN, TANH_TABLE5, measured_recording
+from harvester.initial import recording_priors
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning", "ignore::RuntimeWarning")
 
@@ -123,12 +124,12 @@ def test_cli_end_to_end_writes_diagnosis_json(recording, tmp_path, capsys):
 def test_c_m_prior_spans_the_damping_when_the_assumed_friction_over_explains_it():
     # a purely viscous device: Table 1's 8.4 N of friction alone damps more than it shows
     df, _ = measured_recording((), {**TABLE1_KNOWN, "c_m": 180.0}, 20.0, 3)
-    specs = _priors(df, dict(TABLE1_KNOWN), {}, "linear")
+    specs = recording_priors(df, dict(TABLE1_KNOWN), {})
     assert specs["c_m"].mean == 0.0 and 150.0 < specs["c_m"].sd < 210.0
     # a friction measured in static tests is taken as it is, as in the paper
-    specs = _priors(df, dict(TABLE1_KNOWN), {"F_c": {"mean": 0.0, "sd": 1.0}}, "linear")
+    specs = recording_priors(df, dict(TABLE1_KNOWN), {"F_c": {"mean": 0.0, "sd": 1.0}})
     assert specs["c_m"].mean == pytest.approx(180.0, rel=0.05) and specs["c_m"].sd == 50.0
-    specs = _priors(df, dict(TABLE1_KNOWN), {"F_c": {"mean": 8.4, "sd": 1.0}}, "linear")
+    specs = recording_priors(df, dict(TABLE1_KNOWN), {"F_c": {"mean": 8.4, "sd": 1.0}})
     assert specs["c_m"].mean < 9.0 and specs["c_m"].sd == 50.0
     # the quadratic-damping candidate's prior keeps a positive scale
     scale = MotionScale(z=0.01, v=0.05, z_quantiles={0.75: 0.01}, f_high=20.0)

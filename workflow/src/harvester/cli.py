@@ -16,19 +16,9 @@ import logging
 import sys
 from pathlib import Path
 
-
 from harvester.errors import DataError
 
 log = logging.getLogger("harvester.cli")
-
-#: The study's Table 1 (known parameters) and Table 4 priors (F_c, beta, sigma).
-TABLE1_KNOWN = {"M": 12.8, "m": 8.0, "k": 250.0}
-STUDY_PRIORS = {"c_m": (170.0, 50.0, "N s/m"), "F_c": (8.4, 5.0, "N"),
-                "beta": (100.0, 100.0, "s/m"), "sigma": (0.07, 0.03, "m/s^2")}
-TABLE1_F_C = 8.4
-DAMPING_FIT_BAND_HZ = (0.3, 10.0)
-#: c_m below this share of the purely viscous fit counts as driven to zero by the friction.
-AT_ZERO = 0.05
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -97,45 +87,11 @@ def _metadata(recording: Path) -> dict:
     return meta
 
 
-def _priors(df, known: dict, given: dict, baseline: str) -> dict:
-    """Priors of the diagnosis: the study's (Table 4), with c_m's mean from the recording's
-    FRF (``initial.fit_viscous_damping``) given the static friction F_c: measured (the yaml's
-    ``priors.F_c.mean``), as in the paper's initial modelling, or assumed (Table 1's). Where an
-    assumed friction alone over-explains the recording's damping (c_m at zero), c_m is only
-    known to lie between 0 and the purely viscous fit and its prior spans that range: an
-    assumption must not make a prior conflict. Then the priors given in the yaml."""
-    from harvester.initial import fit_viscous_damping
-    from harvester.priors import PriorSpec
-    from harvester.pymc_models import default_prior
-    specs = {n: PriorSpec(n, m, s, u) for n, (m, s, u) in STUDY_PRIORS.items()}
-    f_c = float(given.get("F_c", {}).get("mean", TABLE1_F_C))
-    try:
-        def fit(friction: float) -> float:
-            return float(fit_viscous_damping(df, known["M"], known["m"], known["k"], friction,
-                                             DAMPING_FIT_BAND_HZ,
-                                             lead_in=min(256, len(df) // 4)).c_m)
-        c_m, sd = fit(f_c), STUDY_PRIORS["c_m"][1]
-        log.info("initial modelling: c_m = %.1f N s/m from the recording's FRF (Coulomb "
-                 "friction %.1f N)", c_m, f_c)
-        viscous = fit(0.0) if f_c > 0 and "F_c" not in given else c_m
-        if c_m < AT_ZERO * viscous:
-            c_m, sd = 0.0, max(sd, viscous)
-            log.warning("a friction of %.1f N alone gives more damping than the recording "
-                        "shows (purely viscous fit: c_m = %.1f N s/m); c_m prior 0 +- %.1f "
-                        "N s/m", f_c, viscous, sd)
-        specs["c_m"] = PriorSpec("c_m", c_m, sd, "N s/m")
-    except Exception as err:  # noqa: BLE001 - fall back to Table 1
-        log.warning("FRF damping fit failed (%s); c_m prior centred on Table 1's 170 N s/m", err)
-    for name, spec in given.items():
-        base = specs.get(name) or default_prior(name)
-        specs[name] = PriorSpec(name, float(spec["mean"]), float(spec["sd"]), base.unit,
-                                float(spec.get("lower", base.lower)))
-    return specs
-
-
 def diagnose_command(args: argparse.Namespace) -> int:
     from harvester.daq import read_recording
     from harvester.diagnosis import DiagnosisSettings, check_recording, diagnose
+    from harvester.initial import recording_priors
+    from harvester.paper import TABLE1_KNOWN
     from harvester.signals import filter_recording, sampling_rate
 
     logging.getLogger("pymc").setLevel(logging.ERROR)  # pymc sets INFO when imported
@@ -164,7 +120,7 @@ def diagnose_command(args: argparse.Namespace) -> int:
         DiagnosisSettings(**overrides)
     check_recording(df, str(args.recording), settings.lead_in_s,
                     0.0 if validation is not None else settings.holdout_fraction)
-    priors = _priors(df, known, meta.get("priors", {}), args.baseline)
+    priors = recording_priors(df, known, meta.get("priors", {}), str(args.recording))
     diag = diagnose(df, args.baseline, known, priors, validation=validation,
                     settings=settings, out_dir=args.out, source=str(args.recording))
     print(f"{diag.verdict}" + (f": {', '.join(diag.missing)}" if diag.missing else "")

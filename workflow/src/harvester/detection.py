@@ -63,9 +63,10 @@ def run_diagnosis(recording: pd.DataFrame, baseline: str, known: Mapping[str, fl
     """
     from harvester.diagnosis.run import DiagnosisSettings, diagnose
     from harvester.priors import PriorSpec
+    from harvester.signals import uniform_step
 
     start = time.perf_counter()
-    dt = float(np.median(np.diff(recording["time"].to_numpy())))
+    dt = uniform_step(recording["time"].to_numpy())
     common = dict(seed=seed, lead_in_s=lead_in * dt, lowpass_hz=lowpass_hz,
                   filter_order=filter_order, figures=False,
                   candidates=tuple(candidates) if candidates else None)

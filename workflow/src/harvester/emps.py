@@ -55,6 +55,7 @@ from harvester.daq import sha256 as file_sha256
 from harvester.errors import DataError
 from harvester.likelihood import Problem
 from harvester.physics import Layout, step_rates, term
+from harvester.signals import time_base
 from harvester.simulate import BLOW_UP, MAX_SUBSTEPS, RATE_H, Simulation, _rhs, rk4_step
 from harvester.structures import ModelStructure
 
@@ -120,7 +121,7 @@ class EmpsRecord:
 
     @property
     def dt(self) -> float:
-        return float(np.median(np.diff(self.time)))
+        return time_base(self.time)[0]
 
     @property
     def force(self) -> np.ndarray:

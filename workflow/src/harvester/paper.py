@@ -8,6 +8,8 @@ from __future__ import annotations
 
 #: Table 1, initial parameter estimates (SI units).
 TABLE1: dict[str, float] = {"M": 12.8, "m": 8.0, "k": 250.0, "F_c": 8.4, "c_m": 170.0}
+#: The parameters held known (fixed) in every model of the paper.
+TABLE1_KNOWN: dict[str, float] = {k: TABLE1[k] for k in ("M", "m", "k")}
 TABLE1_UNITS: dict[str, str] = {"M": "kg", "m": "kg", "k": "N/m", "F_c": "N", "c_m": "N s/m"}
 
 #: Static friction test: x2 - x1 (m), used in 2 F_c = k (x2 - x1).

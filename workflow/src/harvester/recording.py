@@ -35,6 +35,7 @@ import numpy as np
 import pandas as pd
 
 from harvester.errors import DataError
+from harvester.signals import uniform_step
 
 #: Standard gravity (m/s^2).
 G = 9.80665
@@ -202,6 +203,6 @@ def input_output(df: pd.DataFrame) -> tuple[RecordingKinds, np.ndarray, np.ndarr
     """(kinds, input, output, dt in s) of a recording DataFrame (columns as in the table above)."""
     kinds = recording_kinds(df)
     t = df["time"].to_numpy(dtype=float)
-    dt = float(np.median(np.diff(t)))
+    dt = uniform_step(t)
     return (kinds, df[kinds.input_kind].to_numpy(dtype=float),
             df[kinds.output_kind].to_numpy(dtype=float), dt)

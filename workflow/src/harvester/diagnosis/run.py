@@ -505,7 +505,7 @@ def diagnose_study(recording_df: pd.DataFrame, baseline: str, known: Mapping[str
     """
     rec = recording_df
     if lead_in is not None:
-        fs = 1.0 / float(np.median(np.diff(rec["time"].to_numpy())))
+        fs = 1.0 / uniform_step(rec["time"].to_numpy())
         stop = len(rec) if samples is None else \
             min(len(rec), lead_in + samples + int(round(0.5 * fs)))
         rec = rec.iloc[:stop].reset_index(drop=True)
