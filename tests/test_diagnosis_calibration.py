@@ -40,19 +40,32 @@ def run_detection(df, seed):
                         DiagnosisSettings(bootstrap=400, seed=seed))
 
 
-def null_recording(seed: int, seconds: float = 12.0):
+#: A viscous device for the linear baseline: the c_m of the FRF fit on the rig's recordings.
+LINEAR_C_M = 180.0
+
+
+def null_recording(seed: int, seconds: float = 12.0, baseline: str = "tanh"):
+    """A recording of the baseline itself through the study's measurement chain."""
+    if baseline == "linear":
+        return measured_recording((), {**TABLE1_KNOWN, "c_m": LINEAR_C_M}, seconds,
+                                  3000 + seed)[0]
     return measured_recording(("tanh_friction",), {**TABLE1_KNOWN, **TANH_TABLE5}, seconds,
                               1000 + seed)[0]
 
 
-def test_whole_diagnosis_false_alarms_at_most_5_percent_over_20_seeds():
+@pytest.mark.parametrize("baseline", ["tanh", "linear"])
+def test_whole_diagnosis_false_alarms_at_most_5_percent_over_20_seeds(baseline):
+    """The verdict's false alarms. On the linear baseline the detection screen alone fires
+    more often than its alpha: 16 of 240 seeds of 40 s (6.7 %), with the Coulomb-friction
+    score over-dispersed (z sd 1.16 over 100 seeds, with or without base-sensor noise); the
+    verdict needs evidence as well (``decide_verdict``)."""
     settings = DiagnosisSettings.fast(particles=100, figures=False)
     verdicts = []
     for seed in range(20):
-        d = diagnose(null_recording(seed), "tanh", TABLE1_KNOWN, PRIORS,
+        d = diagnose(null_recording(seed, baseline=baseline), baseline, TABLE1_KNOWN, PRIORS,
                      settings=DiagnosisSettings(**{**settings.__dict__, "seed": seed}))
         verdicts.append(d.verdict)
-        print(seed, d.verdict, d.missing, f"p={d.rounds[0].detection.p_value:.3f}")
+        print(baseline, seed, d.verdict, d.missing, f"p={d.rounds[0].detection.p_value:.3f}")
     alarms = sum(v == "missing_physics" for v in verdicts)
     assert alarms <= 1, f"{alarms} false alarms in 20"
 
