@@ -56,9 +56,8 @@ def null_recording(seed: int, seconds: float = 12.0, baseline: str = "tanh"):
 @pytest.mark.parametrize("baseline", ["tanh", "linear"])
 def test_whole_diagnosis_false_alarms_at_most_5_percent_over_20_seeds(baseline):
     """The verdict's false alarms. On the linear baseline the detection screen alone fires
-    more often than its alpha: 16 of 240 seeds of 40 s (6.7 %), with the Coulomb-friction
-    score over-dispersed (z sd 1.16 over 100 seeds, with or without base-sensor noise); the
-    verdict needs evidence as well (``decide_verdict``)."""
+    somewhat more often than its alpha (16 of 240 seeds of 40 s, 6.7 %; 6 of 41 records of
+    an independent simulator); the verdict needs evidence as well (``decide_verdict``)."""
     settings = DiagnosisSettings.fast(particles=100, figures=False)
     verdicts = []
     for seed in range(20):
