@@ -75,6 +75,10 @@ def test_bad_metadata_and_options_get_clear_errors(recording, tmp_path, capsys):
     code, err = _run(["diagnose", str(path), "--baseline", "linear", "--out",
                       str(tmp_path / "o"), "--log", str(tmp_path / "l.txt")], capsys)
     assert code == 2 and "unknown key" in err
+    (tmp_path / "r.yaml").write_text("priors:\n  damping: {mean: 9.0, sd: 1.0}\n")
+    code, err = _run(["diagnose", str(path), "--baseline", "linear", "--out",
+                      str(tmp_path / "o"), "--log", str(tmp_path / "l.txt")], capsys)
+    assert code == 2 and "r.yaml" in err and "no prior for parameter 'damping'" in err
     (tmp_path / "r.yaml").unlink()
     code, err = _run(["diagnose", str(path), "--baseline", "linear", "--out",
                       str(tmp_path / "o"), "--lowpass", "500", "--log",

@@ -120,7 +120,10 @@ def diagnose_command(args: argparse.Namespace) -> int:
         DiagnosisSettings(**overrides)
     check_recording(df, str(args.recording), settings.lead_in_s,
                     0.0 if validation is not None else settings.holdout_fraction)
-    priors = recording_priors(df, known, meta.get("priors", {}), str(args.recording))
+    try:
+        priors = recording_priors(df, known, meta.get("priors", {}), str(args.recording))
+    except KeyError as err:  # a prior in the sidecar for a parameter the library lacks
+        raise DataError(args.recording.with_suffix(".yaml"), str(err.args[0])) from None
     diag = diagnose(df, args.baseline, known, priors, validation=validation,
                     settings=settings, out_dir=args.out, source=str(args.recording))
     print(f"{diag.verdict}" + (f": {', '.join(diag.missing)}" if diag.missing else "")

@@ -34,7 +34,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import optimize
 
 from harvester.errors import DataError
-from harvester.priors import PriorSpec
+from harvester.priors import PriorSpec, prior_spec
 from harvester.signals import SEGMENT_S, frf_h1, sampling_rate
 
 log = logging.getLogger("harvester.initial")
@@ -387,10 +387,11 @@ def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
                      source: str = "<recording>") -> dict[str, PriorSpec]:
     """Priors for one recording of a device whose M, m, k are ``known``: the paper's Table 4,
     with c_m's mean from the recording's FRF (:func:`fit_viscous_damping`) as in the initial
-    modelling, then the priors ``given`` (name -> mean, sd[, lower], e.g. a sidecar's).
+    modelling, then the priors ``given`` (name -> entry as in config ``priors``:
+    mean or from: table1, sd, optional lower; e.g. a sidecar's).
 
-    The FRF fit needs the static friction F_c: measured (``given["F_c"]["mean"]``) or assumed
-    (Table 1's 8.4 N). Where an assumed friction alone explains more damping than the
+    The FRF fit needs the static friction F_c: measured (the mean of ``given["F_c"]``) or
+    assumed (Table 1's 8.4 N). Where an assumed friction alone explains more damping than the
     recording shows (c_m below ``AT_ZERO`` x the purely viscous fit), c_m is only known to lie
     between 0 and the viscous fit, and its prior spans that range: an assumption must not make
     a prior conflict. A measured friction keeps its fit, and the conflict stands.
@@ -398,11 +399,15 @@ def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
     from harvester.paper import TABLE1, TABLE4
     from harvester.pymc_models import default_prior
 
-    given = dict(given or {})
     units = {"c_m": "N s/m", "F_c": "N", "beta": "s/m", "sigma": "m/s^2"}
     specs = {n: PriorSpec(n, m_, s_, units[n]) for n, (m_, s_) in TABLE4.items()}
-    measured = "F_c" in given
-    f_c = float(given["F_c"]["mean"]) if measured else TABLE1["F_c"]
+    stated = {}
+    for name, entry in (given or {}).items():
+        base = specs.get(name) or default_prior(name)
+        stated[name] = prior_spec(name, {"unit": base.unit, "lower": base.lower, **entry},
+                                  TABLE1)
+    measured = "F_c" in stated
+    f_c = stated["F_c"].mean if measured else TABLE1["F_c"]
     lead_in = min(256, len(df) // 4)
 
     def fit(friction: float) -> float:
@@ -411,20 +416,16 @@ def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
 
     try:
         c_m, sd = fit(f_c), TABLE4["c_m"][1]
+        viscous = fit(0.0) if f_c > 0 and not measured else c_m
     except (DataError, ValueError, np.linalg.LinAlgError) as err:
         log.warning("FRF damping fit failed (%s); c_m prior is Table 4's", err)
     else:
         log.info("initial modelling: c_m = %.1f N s/m from the recording's FRF (Coulomb "
                  "friction %.1f N, %s)", c_m, f_c, "measured" if measured else "assumed")
-        viscous = fit(0.0) if f_c > 0 and not measured else c_m
         if c_m < AT_ZERO * viscous:
             c_m, sd = 0.0, max(sd, viscous)
             log.warning("a friction of %.1f N alone gives more damping than the recording "
                         "shows (purely viscous fit: c_m = %.1f N s/m); c_m prior 0 +- %.1f "
                         "N s/m", f_c, viscous, sd)
         specs["c_m"] = PriorSpec("c_m", c_m, sd, units["c_m"])
-    for name, spec in given.items():
-        base = specs.get(name) or default_prior(name)
-        specs[name] = PriorSpec(name, float(spec["mean"]), float(spec["sd"]), base.unit,
-                                float(spec.get("lower", base.lower)))
-    return specs
+    return {**specs, **stated}
