@@ -125,12 +125,23 @@ def test_cli_end_to_end_writes_diagnosis_json(recording, tmp_path, capsys):
     assert "verdict" in (tmp_path / "progress.log").read_text()
 
 
-def test_c_m_prior_spans_the_damping_when_the_assumed_friction_over_explains_it():
-    # a purely viscous device: Table 1's 8.4 N of friction alone damps more than it shows
+def test_without_a_measured_friction_the_priors_span_the_damping_split():
+    # a purely viscous device: c_m lies between 0 and the viscous fit, F_c between 0 and the
+    # friction that alone gives that damping
     df, _ = measured_recording((), {**TABLE1_KNOWN, "c_m": 180.0}, 20.0, 3)
     specs = recording_priors(df, dict(TABLE1_KNOWN), {})
     assert specs["c_m"].mean == 0.0 and 150.0 < specs["c_m"].sd < 210.0
+    assert specs["F_c"].mean == 0.0 and specs["F_c"].sd > 1.0
+    # a device far from the paper's (Table 4: F_c 8.4 +- 5 N): its friction and damping lie
+    # inside the priors, and nothing assumed puts them in a prior's tail
+    far = {**TABLE1_KNOWN, "c_m": 40.0, "F_c": 30.0, "beta": 200.0}
+    df, _ = measured_recording(("tanh_friction",), far, 20.0, 4, peak_m_s2=8.0)
+    specs = recording_priors(df, dict(TABLE1_KNOWN), {})
+    for name in ("c_m", "F_c"):
+        assert specs[name].mean == 0.0
+        assert specs[name].distribution().sf(far[name]) > 0.05, (name, specs[name])
     # a friction measured in static tests is taken as it is, as in the paper
+    df, _ = measured_recording((), {**TABLE1_KNOWN, "c_m": 180.0}, 20.0, 3)
     specs = recording_priors(df, dict(TABLE1_KNOWN), {"F_c": {"mean": 0.0, "sd": 1.0}})
     assert specs["c_m"].mean == pytest.approx(180.0, rel=0.05) and specs["c_m"].sd == 50.0
     specs = recording_priors(df, dict(TABLE1_KNOWN), {"F_c": {"mean": 8.4, "sd": 1.0}})

@@ -33,3 +33,41 @@ def test_candidates_similar_to_a_chosen_one_are_sampled_too():
     assert chosen == ["stribeck_friction", "tanh_friction", "coulomb_friction"]
     assert [r.effect for r in to_confirm(ranked, detection, top=2, similar_extra=0)] == \
         ["stribeck_friction", "tanh_friction"]
+
+
+def test_prior_data_conflict_judges_what_the_data_alone_say():
+    import numpy as np
+    import pytest
+
+    from harvester.diagnosis.detect import DetectionSettings, data_estimate, prior_conflicts
+    from harvester.priors import PriorSpec
+
+    # conjugate Gaussian: prior N(0, 1), likelihood N(3, 0.5^2) -> posterior N(2.4, 0.2)
+    m_l, s_l = data_estimate(0.0, 1.0, 2.4, np.sqrt(0.2))
+    assert m_l == pytest.approx(3.0) and s_l == pytest.approx(0.5)
+    rng = np.random.default_rng(0)
+    prior = {"c_m": PriorSpec("c_m", 0.0, 1.0, "N s/m", -np.inf)}
+    settings = DetectionSettings(conflict_alpha=0.01)
+
+    def flagged(post_mean, post_sd):
+        x = post_mean + post_sd * rng.standard_normal((200_000, 1))
+        (c,) = prior_conflicts(("c_m",), x, prior, settings)
+        return c.z, c.conflict
+
+    # the data put the parameter at 4 +- 0.8 (z = 4 / sqrt(1 + 0.64)): a conflict, although
+    # the posterior (2.44 +- 0.62) is neither narrow nor far out in the prior's tail
+    z, hit = flagged(*_posterior(0.0, 1.0, 4.0, 0.8))
+    assert hit and z == pytest.approx(4.0 / np.sqrt(1.64), abs=0.02)
+    # data that barely inform it: the posterior moved, but the prior predicts such data
+    z, hit = flagged(*_posterior(0.0, 1.0, 4.0, 3.0))
+    assert not hit and abs(z) < 1.5
+    # the data agree with the prior
+    assert not flagged(*_posterior(0.0, 1.0, 0.5, 0.2))[1]
+
+
+def _posterior(m0, s0, m_l, s_l):
+    """Conjugate Gaussian posterior (mean, sd)."""
+    import numpy as np
+
+    prec = 1 / s0**2 + 1 / s_l**2
+    return (m0 / s0**2 + m_l / s_l**2) / prec, float(np.sqrt(1 / prec))

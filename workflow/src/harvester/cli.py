@@ -3,10 +3,10 @@
 RECORDING.csv has a header and the columns time (s, uniform), base_acc and rel_acc (m/s^2).
 An optional RECORDING.yaml beside it gives the known parameters ``M``, ``m``, ``k`` (default:
 the study's Table 1), and may give ``priors`` (``{name: {mean, sd}}``) and ``filtered_at_hz``
-(the cut-off of a zero-phase low-pass the recording already went through). The prior of
-c_m is centred, as in the paper's initial modelling, on the viscous damping fitted to the
-recording's frequency response with Coulomb friction F_c = 8.4 N (Table 1); the others are the
-study's (Table 4). Progress goes to stderr, or to ``--log FILE``.
+(the cut-off of a zero-phase low-pass the recording already went through). The priors of
+c_m and F_c come from the recording's frequency response (``initial.recording_priors``: centred
+on its FRF fit when a static friction is given in ``priors``, else spanning the damping's split
+between the two); beta's is the study's (Table 4). Progress goes to stderr, or to ``--log FILE``.
 """
 
 from __future__ import annotations

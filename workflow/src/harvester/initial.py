@@ -378,54 +378,61 @@ def fit_viscous_damping(df: pd.DataFrame, M: float, m: float, k: float, F_c: flo
 #: Band (Hz) of the FRF damping fit of a single recording (the study's config
 #: ``initial.damping_fit_band_hz``).
 DAMPING_FIT_BAND_HZ = (0.3, 10.0)
-#: c_m below this share of the purely viscous fit counts as driven to zero by the friction.
-AT_ZERO = 0.05
 
 
 def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
                      given: Mapping[str, Mapping[str, float]] | None = None,
                      source: str = "<recording>") -> dict[str, PriorSpec]:
-    """Priors for one recording of a device whose M, m, k are ``known``: the paper's Table 4,
-    with c_m's mean from the recording's FRF (:func:`fit_viscous_damping`) as in the initial
-    modelling, then the priors ``given`` (name -> entry as in config ``priors``:
-    mean or from: table1, sd, optional lower; e.g. a sidecar's).
+    """Priors for one recording of a device whose M, m, k are ``known``: the paper's Table 4
+    for beta, c_m (and F_c) from the recording's FRF (:func:`fit_viscous_damping`) as in the
+    initial modelling, then the priors ``given`` (name -> entry as in config ``priors``: mean
+    or from: table1, sd, optional lower; e.g. a sidecar's). sigma's prior is left to the
+    diagnosis (scaled to the recording's residual, ``diagnosis.run.default_priors``) unless
+    given: Table 4's is the paper's rig's noise.
 
-    The FRF fit needs the static friction F_c: measured (the mean of ``given["F_c"]``) or
-    assumed (Table 1's 8.4 N). Where an assumed friction alone explains more damping than the
-    recording shows (c_m below ``AT_ZERO`` x the purely viscous fit), c_m is only known to lie
-    between 0 and the viscous fit, and its prior spans that range: an assumption must not make
-    a prior conflict. A measured friction keeps its fit, and the conflict stands.
+    With a measured static friction (``given["F_c"]``, as the paper's static tests give) c_m's
+    mean is the FRF fit with that friction, sd Table 4's, as in the paper (a measured friction
+    that alone damps more than the recording shows drives c_m's posterior to zero, and that
+    conflict is evidence). Without one, the recording's damping cannot be split
+    between viscous damping and friction, and an assumed split must not make a prior conflict:
+    c_m is only known to lie between 0 and the purely viscous fit c_v, and F_c between 0 and
+    the friction that alone gives that damping, sqrt(pi/2) c_v sigma_v (equivalent
+    linearisation, c_eq = sqrt(2/pi) F_c / sigma_v): each prior is N(0, bound) truncated at 0.
     """
     from harvester.paper import TABLE1, TABLE4
     from harvester.pymc_models import default_prior
 
-    units = {"c_m": "N s/m", "F_c": "N", "beta": "s/m", "sigma": "m/s^2"}
-    specs = {n: PriorSpec(n, m_, s_, units[n]) for n, (m_, s_) in TABLE4.items()}
+    units = {"c_m": "N s/m", "F_c": "N", "beta": "s/m"}
+    specs = {n: PriorSpec(n, m_, s_, units[n]) for n, (m_, s_) in TABLE4.items()
+             if n != "sigma"}
     stated = {}
     for name, entry in (given or {}).items():
         base = specs.get(name) or default_prior(name)
         stated[name] = prior_spec(name, {"unit": base.unit, "lower": base.lower, **entry},
                                   TABLE1)
-    measured = "F_c" in stated
-    f_c = stated["F_c"].mean if measured else TABLE1["F_c"]
     lead_in = min(256, len(df) // 4)
 
-    def fit(friction: float) -> float:
+    def fit(friction: float) -> DampingFit:
         return fit_viscous_damping(df, known["M"], known["m"], known["k"], friction,
-                                   DAMPING_FIT_BAND_HZ, lead_in=lead_in, source=source).c_m
+                                   DAMPING_FIT_BAND_HZ, lead_in=lead_in, source=source)
 
     try:
-        c_m, sd = fit(f_c), TABLE4["c_m"][1]
-        viscous = fit(0.0) if f_c > 0 and not measured else c_m
+        if "F_c" in stated:
+            f_c = stated["F_c"].mean
+            c_m = fit(f_c).c_m
+            log.info("initial modelling: c_m = %.1f N s/m from the recording's FRF with the "
+                     "measured friction %.1f N", c_m, f_c)
+            specs["c_m"] = PriorSpec("c_m", c_m, TABLE4["c_m"][1], units["c_m"])
+        else:
+            viscous = fit(0.0)
+            floor = 1e-6 * np.sqrt(known["k"] * known["M"])
+            c_v = max(viscous.c_m, floor)
+            f_max = max(np.sqrt(np.pi / 2.0) * c_v * viscous.sigma_v, 1e-3)
+            log.info("initial modelling: the recording's FRF gives c_m = %.1f N s/m without "
+                     "friction (RMS velocity %.3g m/s); no measured friction, so c_m lies in "
+                     "0-%.1f N s/m and F_c in 0-%.2f N", c_v, viscous.sigma_v, c_v, f_max)
+            specs["c_m"] = PriorSpec("c_m", 0.0, c_v, units["c_m"])
+            specs["F_c"] = PriorSpec("F_c", 0.0, float(f_max), units["F_c"])
     except (DataError, ValueError, np.linalg.LinAlgError) as err:
-        log.warning("FRF damping fit failed (%s); c_m prior is Table 4's", err)
-    else:
-        log.info("initial modelling: c_m = %.1f N s/m from the recording's FRF (Coulomb "
-                 "friction %.1f N, %s)", c_m, f_c, "measured" if measured else "assumed")
-        if c_m < AT_ZERO * viscous:
-            c_m, sd = 0.0, max(sd, viscous)
-            log.warning("a friction of %.1f N alone gives more damping than the recording "
-                        "shows (purely viscous fit: c_m = %.1f N s/m); c_m prior 0 +- %.1f "
-                        "N s/m", f_c, viscous, sd)
-        specs["c_m"] = PriorSpec("c_m", c_m, sd, units["c_m"])
+        log.warning("FRF damping fit failed (%s); c_m and F_c priors are Table 4's", err)
     return {**specs, **stated}

@@ -24,8 +24,8 @@ where, not whether: sensor noise on the base channel seen through sticking and s
 residual's level follow the motion even when the structure is right, so energy shares are
 reported (and flagged when significant and gross) but do not decide the verdict.
 
-Prior-to-posterior conflicts (the posterior mean far in the prior's tail while the data
-dominate) are reported beside it: a missing effect that the parameters absorb leaves
+Prior-data conflicts (what the data alone say of a parameter, far in the tail of what its
+prior predicts) are reported beside it: a missing effect that the parameters absorb leaves
 white-looking residuals but drags the parameters away from what the initial modelling said;
 the diagnosis then confirms candidates by evidence (``confirm.py``).
 """
@@ -62,9 +62,8 @@ class DetectionSettings:
     gross_region_ratio, gross_window_ratio: a region (window) counts towards the verdict only
     when it holds at least this many times its share of time (expected share) of the residual
     energy, besides being significant (see :func:`detect`); window_s: length of
-    the time windows (s); conflict_alpha: family-wise level of the prior-posterior conflict
-    flags; conflict_data_dominated: a conflict needs posterior sd below this fraction of the
-    prior sd; seed: replicates' random seed.
+    the time windows (s); conflict_alpha: family-wise level of the prior-data conflict flags
+    (``prior_conflicts``); seed: replicates' random seed.
     """
 
     bootstrap: int = 400
@@ -75,13 +74,13 @@ class DetectionSettings:
     gross_window_ratio: float = 2.0
     window_s: float = 1.0
     conflict_alpha: float = 0.01
-    conflict_data_dominated: float = 0.5
     seed: int = 0
 
 
 @dataclass
 class Conflict:
-    """Where a posterior sits in its prior: z in prior sds and the prior's two-sided tail mass."""
+    """Prior-data conflict of one parameter: z of the data's estimate against the prior's
+    prediction of it, its two-sided tail probability, and the flag (``prior_conflicts``)."""
 
     parameter: str
     prior_mean: float
@@ -177,10 +176,34 @@ def estimate_temper(residual: np.ndarray, window: tuple[int, int], fs: float,
     return temper_from_spectrum(dft, frame.smoothed_periodogram(dft), frame)
 
 
+def data_estimate(prior_mean: float, prior_sd: float, post_mean: float, post_sd: float
+                  ) -> tuple[float, float]:
+    """(mean, sd) of the likelihood alone, recovered from a Gaussian prior and posterior:
+    1/s_L^2 = 1/s_post^2 - 1/s_0^2, m_L = s_L^2 (m_post/s_post^2 - m_0/s_0^2); sd inf where the
+    data say nothing the prior did not (posterior no narrower than the prior)."""
+    if post_sd <= 0.0:
+        return post_mean, 0.0
+    precision = 1.0 / post_sd**2 - 1.0 / prior_sd**2
+    if precision <= 0.0:
+        return post_mean, float("inf")
+    var = 1.0 / precision
+    return float(var * (post_mean / post_sd**2 - prior_mean / prior_sd**2)), float(np.sqrt(var))
+
+
 def prior_conflicts(names: tuple[str, ...], samples: np.ndarray,
                     priors: Mapping[str, PriorSpec], settings: DetectionSettings
                     ) -> list[Conflict]:
-    """Prior-to-posterior check of every physical parameter (sigma excluded)."""
+    """Prior-data conflict of every physical parameter (sigma excluded).
+
+    What the data alone say of a parameter (``data_estimate``) is compared with the prior's
+    prediction of it: z = (m_L - m_0) / sqrt(s_0^2 + s_L^2), N(0, 1) when the prior is right
+    (a Gaussian prior-predictive check; truncation at the lower bound is ignored). A
+    parameter the data barely inform gets s_L large and z small, however far its posterior
+    moved; one the data pin down is judged on its distance in prior sds. Flagged below the
+    family-wise level ``conflict_alpha`` (two-sided).
+    """
+    from scipy.stats import norm
+
     out = []
     physical = [n for n in names if n != "sigma"]
     level = settings.conflict_alpha / max(len(physical), 1)
@@ -191,15 +214,11 @@ def prior_conflicts(names: tuple[str, ...], samples: np.ndarray,
         x = samples[:, j]
         mean = float(np.mean(x))
         sd = float(np.std(x, ddof=1)) if len(x) > 1 else 0.0
-        if np.isfinite(spec.lower):
-            cdf = float(spec.distribution().cdf(mean))
-        else:
-            from scipy.stats import norm
-            cdf = float(norm.cdf(mean, spec.mean, spec.sd))
-        tail = float(min(1.0, 2.0 * min(cdf, 1.0 - cdf)))
-        z = (mean - spec.mean) / spec.sd
-        flagged = tail < level and sd < settings.conflict_data_dominated * spec.sd
-        out.append(Conflict(name, spec.mean, spec.sd, mean, sd, float(z), tail, bool(flagged)))
+        m_l, s_l = data_estimate(spec.mean, spec.sd, mean, sd)
+        z = 0.0 if not np.isfinite(s_l) else (m_l - spec.mean) / float(np.hypot(spec.sd, s_l))
+        tail = float(2.0 * norm.sf(abs(z)))
+        out.append(Conflict(name, spec.mean, spec.sd, mean, sd, float(z), tail,
+                            bool(tail < level)))
     return out
 
 
