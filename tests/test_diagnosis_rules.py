@@ -71,3 +71,16 @@ def _posterior(m0, s0, m_l, s_l):
 
     prec = 1 / s0**2 + 1 / s_l**2
     return (m0 / s0**2 + m_l / s_l**2) / prec, float(np.sqrt(1 / prec))
+
+
+def test_a_prior_conflict_gets_its_best_reliever_sampled():
+    ranked = [_ranked("backlash", 0.003, 9.3),
+              _ranked("unmodelled_mode", 0.6, 2.6),
+              _ranked("quadratic_damping", 0.4, 1.1)]
+    ranked[1].conflict_relief, ranked[2].conflict_relief = 0.1, 1.5
+    quiet = SimpleNamespace(alpha=0.05, conflict=False)
+    assert [r.effect for r in to_confirm(ranked, quiet, top=3)] == ["backlash"]
+    # the conflict is the only trace of an effect the parameters absorb completely
+    conflict = SimpleNamespace(alpha=0.05, conflict=True)
+    assert [r.effect for r in to_confirm(ranked, conflict, top=3)] == \
+        ["backlash", "quadratic_damping"]

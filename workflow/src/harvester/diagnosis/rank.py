@@ -111,7 +111,10 @@ def to_confirm(ranked: list[RankedCandidate], detection: Detection, top: int,
     relieving a prior conflict, and with delta_chi2 of at least ``min_delta_chi2``; plus up to
     ``similar_extra`` eligible candidates whose signatures are similar to a chosen one's (the
     ranking cannot tell them apart, so the evidence must: a Coulomb law beside tanh and
-    Stribeck laws, say)."""
+    Stribeck laws, say); plus, when a prior conflict is flagged, the candidate that relieves it
+    most. The relief is linearised, and an effect the parameters absorb completely leaves no
+    score to support it (quadratic damping taken up by c_m, say): the conflict is then its
+    only trace, and the evidence decides."""
     eligible = [r for r in ranked
                 if (r.score.p_value < detection.alpha
                     or (detection.conflict and r.conflict_relief > min_delta_chi2))
@@ -120,5 +123,9 @@ def to_confirm(ranked: list[RankedCandidate], detection: Detection, top: int,
     names = {r.effect for r in chosen}
     similar = {e for r in chosen for e in r.similar}
     extra = [r for r in ranked if r.effect in similar and r.effect not in names
-             and r.delta_chi2 >= min_delta_chi2]
-    return chosen + extra[:similar_extra]
+             and r.delta_chi2 >= min_delta_chi2][:similar_extra]
+    names |= {r.effect for r in extra}
+    relieving = [r for r in ranked if detection.conflict and r.conflict_relief > 0.0
+                 and r.effect not in names]
+    best_relief = sorted(relieving, key=lambda r: -r.conflict_relief)[:1]
+    return chosen + extra + best_relief
