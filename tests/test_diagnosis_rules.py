@@ -77,7 +77,7 @@ def test_a_prior_conflict_gets_its_best_reliever_sampled():
     ranked = [_ranked("backlash", 0.003, 9.3),
               _ranked("unmodelled_mode", 0.6, 2.6),
               _ranked("quadratic_damping", 0.4, 1.1)]
-    ranked[1].conflict_relief, ranked[2].conflict_relief = 0.1, 1.5
+    ranked[1].relief_alone, ranked[2].relief_alone = 0.1, 1.5
     quiet = SimpleNamespace(alpha=0.05, conflict=False)
     assert [r.effect for r in to_confirm(ranked, quiet, top=3)] == ["backlash"]
     # the conflict is the only trace of an effect the parameters absorb completely

@@ -46,6 +46,7 @@ class RankedCandidate:
     conflict_relief: float  # part of delta_chi2 from moving the parameters back to the prior
     strength: float  # combined estimate a*
     similar: list[str] = field(default_factory=list)
+    relief_alone: float = 0.0  # the conflict's relief with a fitted to the conflict alone
 
     @property
     def rank_score(self) -> float:
@@ -57,7 +58,7 @@ class RankedCandidate:
                 "explained_share": self.score.explained_share,
                 "strength": self.score.strength, "strength_se": self.score.strength_se,
                 "delta_chi2": self.delta_chi2, "conflict_relief": self.conflict_relief,
-                "similar": self.similar}
+                "relief_alone": self.relief_alone, "similar": self.similar}
 
 
 def _prior_offsets(state: BaselineState, priors: Mapping[str, PriorSpec]
@@ -90,7 +91,12 @@ def rank(detection: Detection, state: BaselineState, priors: Mapping[str, PriorS
         prior_part = float(np.sum(((d - a * A) / s) ** 2))
         qa = prior_part + ((c.strength - a) / se) ** 2
         relief = q0_prior - prior_part
-        out.append(RankedCandidate(c.effect, c, float(q0 - qa), float(relief), float(a)))
+        a_alone = float(np.sum(d * A / s**2)) / max(float(np.sum(A**2 / s**2)), 1e-300)
+        if not sig.signed:
+            a_alone = max(a_alone, 0.0)
+        alone = q0_prior - float(np.sum(((d - a_alone * A) / s) ** 2))
+        out.append(RankedCandidate(c.effect, c, float(q0 - qa), float(relief), float(a),
+                                   relief_alone=float(alone)))
     # similarity of the best signatures
     G = detection.signature_dft
     if len(out) > 1 and G.size:
@@ -112,8 +118,9 @@ def to_confirm(ranked: list[RankedCandidate], detection: Detection, top: int,
     ``similar_extra`` eligible candidates whose signatures are similar to a chosen one's (the
     ranking cannot tell them apart, so the evidence must: a Coulomb law beside tanh and
     Stribeck laws, say); plus, when a prior conflict is flagged, the candidate that relieves it
-    most. The relief is linearised, and an effect the parameters absorb completely leaves no
-    score to support it (quadratic damping taken up by c_m, say): the conflict is then its
+    most with its strength fitted to the conflict alone (``relief_alone``): an effect the
+    parameters absorb completely leaves no score to support it, or one of the wrong sign where
+    the refit overshoots (quadratic damping taken up by c_m, say); the conflict is then its
     only trace, and the evidence decides."""
     eligible = [r for r in ranked
                 if (r.score.p_value < detection.alpha
@@ -125,7 +132,7 @@ def to_confirm(ranked: list[RankedCandidate], detection: Detection, top: int,
     extra = [r for r in ranked if r.effect in similar and r.effect not in names
              and r.delta_chi2 >= min_delta_chi2][:similar_extra]
     names |= {r.effect for r in extra}
-    relieving = [r for r in ranked if detection.conflict and r.conflict_relief > 0.0
+    relieving = [r for r in ranked if detection.conflict and r.relief_alone > 0.0
                  and r.effect not in names]
-    best_relief = sorted(relieving, key=lambda r: -r.conflict_relief)[:1]
+    best_relief = sorted(relieving, key=lambda r: -r.relief_alone)[:1]
     return chosen + extra + best_relief
