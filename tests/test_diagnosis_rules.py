@@ -4,7 +4,12 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
+import numpy as np
+import pytest
+
+from harvester.diagnosis.detect import DetectionSettings, data_estimate, prior_conflicts
 from harvester.diagnosis.rank import RankedCandidate, to_confirm
+from harvester.priors import PriorSpec
 from harvester.diagnosis.run import decide_verdict
 
 
@@ -36,12 +41,6 @@ def test_candidates_similar_to_a_chosen_one_are_sampled_too():
 
 
 def test_prior_data_conflict_judges_what_the_data_alone_say():
-    import numpy as np
-    import pytest
-
-    from harvester.diagnosis.detect import DetectionSettings, data_estimate, prior_conflicts
-    from harvester.priors import PriorSpec
-
     # conjugate Gaussian: prior N(0, 1), likelihood N(3, 0.5^2) -> posterior N(2.4, 0.2)
     m_l, s_l = data_estimate(0.0, 1.0, 2.4, np.sqrt(0.2))
     assert m_l == pytest.approx(3.0) and s_l == pytest.approx(0.5)
@@ -67,8 +66,6 @@ def test_prior_data_conflict_judges_what_the_data_alone_say():
 
 def _posterior(m0, s0, m_l, s_l):
     """Conjugate Gaussian posterior (mean, sd)."""
-    import numpy as np
-
     prec = 1 / s0**2 + 1 / s_l**2
     return (m0 / s0**2 + m_l / s_l**2) / prec, float(np.sqrt(1 / prec))
 

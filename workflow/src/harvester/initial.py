@@ -402,9 +402,8 @@ def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
     from harvester.paper import TABLE1, TABLE4
     from harvester.pymc_models import default_prior
 
-    units = {"c_m": "N s/m", "F_c": "N", "beta": "s/m"}
-    specs = {n: PriorSpec(n, m_, s_, units[n]) for n, (m_, s_) in TABLE4.items()
-             if n != "sigma"}
+    unit = {n: default_prior(n).unit for n in ("c_m", "F_c", "beta")}
+    specs = {n: PriorSpec(n, m_, s_, unit[n]) for n, (m_, s_) in TABLE4.items() if n in unit}
     stated = {}
     for name, entry in (given or {}).items():
         base = specs.get(name) or default_prior(name)
@@ -422,7 +421,7 @@ def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
             c_m = fit(f_c).c_m
             log.info("initial modelling: c_m = %.1f N s/m from the recording's FRF with the "
                      "measured friction %.1f N", c_m, f_c)
-            specs["c_m"] = PriorSpec("c_m", c_m, TABLE4["c_m"][1], units["c_m"])
+            specs["c_m"] = PriorSpec("c_m", c_m, TABLE4["c_m"][1], unit["c_m"])
         else:
             viscous = fit(0.0)
             floor = 1e-6 * np.sqrt(known["k"] * known["M"])
@@ -431,8 +430,8 @@ def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
             log.info("initial modelling: the recording's FRF gives c_m = %.1f N s/m without "
                      "friction (RMS velocity %.3g m/s); no measured friction, so c_m lies in "
                      "0-%.1f N s/m and F_c in 0-%.2f N", c_v, viscous.sigma_v, c_v, f_max)
-            specs["c_m"] = PriorSpec("c_m", 0.0, c_v, units["c_m"])
-            specs["F_c"] = PriorSpec("F_c", 0.0, float(f_max), units["F_c"])
+            specs["c_m"] = PriorSpec("c_m", 0.0, c_v, unit["c_m"])
+            specs["F_c"] = PriorSpec("F_c", 0.0, float(f_max), unit["F_c"])
     except (DataError, ValueError, np.linalg.LinAlgError) as err:
         log.warning("FRF damping fit failed (%s); c_m and F_c priors are Table 4's", err)
     return {**specs, **stated}

@@ -82,21 +82,20 @@ def rank(detection: Detection, state: BaselineState, priors: Mapping[str, PriorS
         sig = detection.signatures[c.index]
         A = detection.absorbed[c.index] if detection.absorbed.size else np.zeros_like(d)
         se = max(c.strength_se, 1e-300)
-        num = float(np.sum(d * A / s**2) + c.strength / se**2)
-        den = float(np.sum(A**2 / s**2) + 1.0 / se**2)
-        a = num / den
-        if not sig.signed:
-            a = max(a, 0.0)
+        num, den = float(np.sum(d * A / s**2)), float(np.sum(A**2 / s**2))
+
+        def fitted(a: float) -> float:
+            return a if sig.signed else max(a, 0.0)
+
+        def prior_part(a: float) -> float:
+            return float(np.sum(((d - a * A) / s) ** 2))
+
+        a = fitted((num + c.strength / se**2) / (den + 1.0 / se**2))  # conflict and score
+        a_alone = fitted(num / max(den, 1e-300))  # the conflict alone
         q0 = q0_prior + (c.strength / se) ** 2
-        prior_part = float(np.sum(((d - a * A) / s) ** 2))
-        qa = prior_part + ((c.strength - a) / se) ** 2
-        relief = q0_prior - prior_part
-        a_alone = float(np.sum(d * A / s**2)) / max(float(np.sum(A**2 / s**2)), 1e-300)
-        if not sig.signed:
-            a_alone = max(a_alone, 0.0)
-        alone = q0_prior - float(np.sum(((d - a_alone * A) / s) ** 2))
-        out.append(RankedCandidate(c.effect, c, float(q0 - qa), float(relief), float(a),
-                                   relief_alone=float(alone)))
+        qa = prior_part(a) + ((c.strength - a) / se) ** 2
+        out.append(RankedCandidate(c.effect, c, float(q0 - qa), q0_prior - prior_part(a),
+                                   float(a), relief_alone=q0_prior - prior_part(a_alone)))
     # similarity of the best signatures
     G = detection.signature_dft
     if len(out) > 1 and G.size:
@@ -132,7 +131,7 @@ def to_confirm(ranked: list[RankedCandidate], detection: Detection, top: int,
     extra = [r for r in ranked if r.effect in similar and r.effect not in names
              and r.delta_chi2 >= min_delta_chi2][:similar_extra]
     names |= {r.effect for r in extra}
-    relieving = [r for r in ranked if detection.conflict and r.relief_alone > 0.0
-                 and r.effect not in names]
-    best_relief = sorted(relieving, key=lambda r: -r.relief_alone)[:1]
-    return chosen + extra + best_relief
+    relieving = [r for r in ranked if r.relief_alone > 0.0 and r.effect not in names]
+    if detection.conflict and relieving:
+        return chosen + extra + [max(relieving, key=lambda r: r.relief_alone)]
+    return chosen + extra
