@@ -137,9 +137,13 @@ def test_without_a_measured_friction_the_priors_span_the_damping_split():
     far = {**TABLE1_KNOWN, "c_m": 40.0, "F_c": 30.0, "beta": 200.0}
     df, _ = measured_recording(("tanh_friction",), far, 20.0, 4, peak_m_s2=8.0)
     specs = recording_priors(df, dict(TABLE1_KNOWN), {})
-    for name in ("c_m", "F_c"):
+    for name in ("c_m", "F_c", "beta"):
         assert specs[name].mean == 0.0
         assert specs[name].distribution().sf(far[name]) > 0.05, (name, specs[name])
+    # a friction law close to a sign law (Table 4's beta 100 +- 100 s/m would put it 50 sd out)
+    sharp = {**far, "beta": 5000.0}
+    df, _ = measured_recording(("tanh_friction",), sharp, 20.0, 4, peak_m_s2=8.0)
+    assert recording_priors(df, dict(TABLE1_KNOWN), {})["beta"].distribution().sf(5000.0) > 0.05
     # a friction measured in static tests is taken as it is, as in the paper
     df, _ = measured_recording((), {**TABLE1_KNOWN, "c_m": 180.0}, 20.0, 3)
     specs = recording_priors(df, dict(TABLE1_KNOWN), {"F_c": {"mean": 0.0, "sd": 1.0}})
@@ -148,4 +152,4 @@ def test_without_a_measured_friction_the_priors_span_the_damping_split():
     assert specs["c_m"].mean < 9.0 and specs["c_m"].sd == 50.0
     # the quadratic-damping candidate's prior keeps a positive scale
     scale = MotionScale(z=0.01, v=0.05, z_quantiles={0.75: 0.01}, f_high=20.0)
-    assert candidate_priors("quadratic_damping", scale, 50.0)["c_quad"].sd > 0.0
+    assert candidate_priors("quadratic_damping", scale)["c_quad"].sd > 0.0

@@ -148,12 +148,18 @@ def test_linear_baseline_on_friction_data_names_friction_and_conflicts_with_prio
     assert det.band_energy.sum() > 0 and np.all(det.band_explained >= 0)
 
 
-def test_a_fast_sampled_recording_is_resampled_to_its_band_and_diagnosed_alike():
-    # the same concealed end stop recorded at 1024 Hz: simulated at 256 Hz, still found
-    settings = ScenarioSettings(duration_s=16.0, fs=1024.0, oversample=4)
+@pytest.mark.parametrize("fs", [1024.0, 400.0])
+def test_a_fast_sampled_recording_is_resampled_to_its_band_and_diagnosed_alike(fs):
+    # the same concealed end stop recorded at 1024 Hz (simulated at 256 Hz, every 4th sample)
+    # and at 400 Hz (no integer factor: resampled by a ratio to 12.8 x the found cut-off)
+    settings = ScenarioSettings(duration_s=16.0, fs=fs, oversample=4)
     sc = make_scenario("end_stop", 0.5, 11, settings, masking=False)
     det, state = run_detection(sc.recording, seed=1)
-    assert state.problem.dt == pytest.approx(1.0 / 256.0)
+    if fs == 1024.0:
+        assert state.problem.dt == pytest.approx(1.0 / 256.0)
+    else:
+        rate, cut = 1.0 / state.problem.dt, state.problem.lowpass_hz
+        assert 12.8 * cut <= rate <= fs / 1.25 and (fs / rate) % 1 > 0.01, (rate, cut)
     assert det.significant, f"p = {det.p_value}"
     top = [r.effect for r in rank(det, state, PRIORS)[:2]]
     assert {"end_stop", "cubic_stiffness"} & set(top), top
@@ -173,3 +179,53 @@ def test_backlash_contact_prior_puts_the_contact_resonance_above_the_band():
                                         for n in layout.parameter_names]]), 1 / 256.0)[0]
             for k in (spec.mean, default_prior("k_backlash").mean)]
     assert cost[0] < cost[1] / 2
+
+
+def test_the_dissipative_force_is_the_power_the_base_puts_in():
+    """c_eq sigma_v from the base's power input matches the simulated dissipation (viscous
+    plus tanh friction) on a noisy low-passed recording, without knowing the split."""
+    from harvester.diagnosis.signatures import dissipative_force
+    from harvester.diagnosis.synthetic import base_excitation
+    from harvester.simulate import simulate
+
+    rng = np.random.default_rng(3)
+    y = base_excitation(int(40 * FS), FS, rng, peak=4.0)
+    values = {**TABLE1_KNOWN, **TANH_TABLE5, "c_m": 60.0, "F_c": 20.0, "beta": 300.0}
+    layout = Layout.of(("tanh_friction",))
+    sim = simulate(layout, np.array([values[p] for p in layout.parameter_names]), y, 1.0 / FS)
+    v = sim.rel_vel[0]
+    truth = np.mean((values["c_m"] * v + values["F_c"] * np.tanh(values["beta"] * v)) * v)
+    truth /= np.sqrt(np.mean(v**2))
+    measured = lowpass(y + 0.04 * rng.standard_normal(y.size), FS, 20.0, 8)
+    estimate = dissipative_force(measured, v, values["m"])
+    assert estimate == pytest.approx(truth, rel=0.03)
+    assert dissipative_force(measured, np.zeros_like(v), values["m"]) is None
+
+
+def test_candidate_priors_follow_the_device_from_the_papers_rig():
+    """On the paper's rig's scales the library's priors are kept; on a device with 4x the
+    dissipative force, 3x the velocity and twice M and k they follow the device."""
+    from harvester.diagnosis.confirm import REFERENCE_SCALE, candidate_priors
+    from harvester.diagnosis.signatures import MotionScale
+
+    ref = REFERENCE_SCALE
+    rig = MotionScale(z=0.01, v=ref["v"], z_quantiles={0.75: 0.01}, f_high=20.0,
+                      force=ref["force"])
+    known = {"M": ref["M"], "m": 8.0, "k": ref["k"]}
+    for effect, name in (("coulomb_friction", "F_coulomb"), ("stribeck_friction", "v_stribeck"),
+                         ("inertia_error", "dM"), ("end_stop", "k_stop")):
+        assert candidate_priors(effect, rig, known)[name] == default_prior(name)
+    other = MotionScale(z=0.01, v=3 * ref["v"], z_quantiles={0.75: 0.01}, f_high=20.0,
+                        force=4 * ref["force"])
+    known2 = {"M": 2 * ref["M"], "m": 8.0, "k": 2 * ref["k"]}
+    for effect, name, ratio in (("coulomb_friction", "F_coulomb", 4.0),
+                                ("stribeck_friction", "F_stribeck", 4.0),
+                                ("stribeck_friction", "v_stribeck", 3.0),
+                                ("tanh_friction", "beta", 1.0 / 3.0),
+                                ("hysteresis", "F_hyst", 4.0),
+                                ("inertia_error", "dM", 2.0), ("end_stop", "k_stop", 2.0)):
+        a, b = candidate_priors(effect, rig, known)[name], candidate_priors(effect, other, known2)[name]
+        assert (b.mean, b.sd) == pytest.approx((a.mean * ratio, a.sd * ratio)), (effect, name)
+    quad = candidate_priors("quadratic_damping", other, known2)["c_quad"]
+    assert quad.sd * other.v**2 == pytest.approx(4 * candidate_priors(
+        "quadratic_damping", rig, known)["c_quad"].sd * rig.v**2)

@@ -138,6 +138,30 @@ def test_decimated_recording_keeps_the_band_and_its_time_base():
     np.testing.assert_allclose(out["rel_acc"], 0.5 * out["base_acc"], atol=1e-12)
 
 
+def test_a_rate_with_no_integer_factor_is_resampled_by_a_ratio():
+    """500 Hz with a 25 Hz filter has no integer factor down to 12.8 x 25 = 320 Hz; it goes
+    to 333 Hz (2/3), and the band's sines come through on the new time base."""
+    from harvester.signals import resample_recording, resampling_ratio
+    assert resampling_ratio(500.0, 25.0) == (2, 3)
+    assert resampling_ratio(1024.0, 20.0) == (1, 4)       # an integer factor is kept
+    assert resampling_ratio(300.0, 20.0) == (1, 1)        # too little to gain
+    fs = 500.0
+    t = np.arange(int(20 * fs)) / fs
+    freqs, phases = np.array([0.7, 5.0, 12.0, 22.0]), np.array([0.1, 1.0, 2.0, 0.4])
+
+    def tones(tt):
+        return np.sin(2 * np.pi * freqs[:, None] * tt[None, :] + phases[:, None]).sum(axis=0)
+
+    df = pd.DataFrame({"time": t, "base_acc": tones(t), "rel_acc": 0.5 * tones(t)})
+    out = resample_recording(df, 2, 3)
+    tt = out["time"].to_numpy()
+    assert list(out.columns) == list(df.columns) and len(out) == pytest.approx(t.size * 2 / 3, abs=1)
+    np.testing.assert_allclose(np.diff(tt), 3 / (2 * fs))
+    err = out["base_acc"].to_numpy() - tones(tt)
+    assert np.sqrt(np.mean(err[300:-300] ** 2)) < 2e-6 * np.std(tones(t))
+    np.testing.assert_allclose(out["rel_acc"], 0.5 * out["base_acc"], atol=1e-12)
+
+
 def test_sampling_rate_accepts_time_written_to_nine_decimals():
     from harvester.signals import sampling_rate
     t = np.round(np.arange(4096) / 1024.0, 9)      # 0.000976562, 0.001953125, ...

@@ -380,12 +380,18 @@ def fit_viscous_damping(df: pd.DataFrame, M: float, m: float, k: float, F_c: flo
 DAMPING_FIT_BAND_HZ = (0.3, 10.0)
 
 
+#: Prior sd of beta sigma_v (sigma_v the RMS velocity) for a recording's device: a tanh law
+#: this steep reverses within 1/50 of the RMS velocity (under 2 % of the samples) and
+#: differs from a sign law no more than the data can tell.
+BETA_SIGMA_V = 50.0
+
+
 def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
                      given: Mapping[str, Mapping[str, float]] | None = None,
                      source: str = "<recording>") -> dict[str, PriorSpec]:
-    """Priors for one recording of a device whose M, m, k are ``known``: the paper's Table 4
-    for beta, c_m (and F_c) from the recording's FRF (:func:`fit_viscous_damping`) as in the
-    initial modelling, then the priors ``given`` (name -> entry as in config ``priors``: mean
+    """Priors for one recording of a device whose M, m, k are ``known``: c_m (and F_c) from the
+    recording's FRF (:func:`fit_viscous_damping`) as in the initial modelling, beta from its
+    RMS velocity, then the priors ``given`` (name -> entry as in config ``priors``: mean
     or from: table1, sd, optional lower; e.g. a sidecar's). sigma's prior is left to the
     diagnosis (scaled to the recording's residual, ``diagnosis.run.default_priors``) unless
     given: Table 4's is the paper's rig's noise.
@@ -398,6 +404,11 @@ def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
     c_m is only known to lie between 0 and the purely viscous fit c_v, and F_c between 0 and
     the friction that alone gives that damping, sqrt(pi/2) c_v sigma_v (equivalent
     linearisation, c_eq = sqrt(2/pi) F_c / sigma_v): each prior is N(0, bound) truncated at 0.
+
+    beta sets the velocity 1/beta over which the friction force reverses; Table 4's 100 +- 100
+    s/m is beta sigma_v = 1.1 +- 1.1 on the paper's rig, but a friction law close to a sign law
+    (beta sigma_v of 75 on a test device, ``BETA_SIGMA_V``) would sit 25 sd in its tail. So
+    beta ~ N(0, BETA_SIGMA_V / sigma_v) truncated at 0, from smooth friction to a sign law.
     """
     from harvester.paper import TABLE1, TABLE4
     from harvester.pymc_models import default_prior
@@ -418,20 +429,25 @@ def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
     try:
         if "F_c" in stated:
             f_c = stated["F_c"].mean
-            c_m = fit(f_c).c_m
+            measured = fit(f_c)
+            c_m, sigma_v = measured.c_m, measured.sigma_v
             log.info("initial modelling: c_m = %.1f N s/m from the recording's FRF with the "
                      "measured friction %.1f N", c_m, f_c)
             specs["c_m"] = PriorSpec("c_m", c_m, TABLE4["c_m"][1], unit["c_m"])
         else:
             viscous = fit(0.0)
             floor = 1e-6 * np.sqrt(known["k"] * known["M"])
-            c_v = max(viscous.c_m, floor)
+            c_v, sigma_v = max(viscous.c_m, floor), viscous.sigma_v
             f_max = max(np.sqrt(np.pi / 2.0) * c_v * viscous.sigma_v, 1e-3)
             log.info("initial modelling: the recording's FRF gives c_m = %.1f N s/m without "
                      "friction (RMS velocity %.3g m/s); no measured friction, so c_m lies in "
                      "0-%.1f N s/m and F_c in 0-%.2f N", c_v, viscous.sigma_v, c_v, f_max)
             specs["c_m"] = PriorSpec("c_m", 0.0, c_v, unit["c_m"])
             specs["F_c"] = PriorSpec("F_c", 0.0, float(f_max), unit["F_c"])
+        if sigma_v > 0.0:
+            specs["beta"] = PriorSpec("beta", 0.0, BETA_SIGMA_V / sigma_v, unit["beta"])
+            log.info("initial modelling: beta lies in 0-%.0f s/m (beta sigma_v up to %g)",
+                     BETA_SIGMA_V / sigma_v, BETA_SIGMA_V)
     except (DataError, ValueError, np.linalg.LinAlgError) as err:
-        log.warning("FRF damping fit failed (%s); c_m and F_c priors are Table 4's", err)
+        log.warning("FRF damping fit failed (%s); c_m, F_c and beta priors are Table 4's", err)
     return {**specs, **stated}

@@ -149,6 +149,30 @@ def decimation_factor(fs: float, cutoff_hz: float | None,
     return max(1, int(np.floor(fs / (rate_per_cutoff * cutoff_hz) + 1e-9)))
 
 
+#: Largest denominator of a rational resampling ratio (``resampling_ratio``), and the least
+#: saving in rate for which a recording is resampled by a non-integer ratio.
+MAX_RESAMPLE_DOWN = 8
+MIN_RESAMPLE_SAVING = 1.25
+
+
+def resampling_ratio(fs: float, cutoff_hz: float | None,
+                     rate_per_cutoff: float = RATE_PER_CUTOFF) -> tuple[int, int]:
+    """(up, down): the recording is resampled to fs up / down >= ``rate_per_cutoff`` x
+    ``cutoff_hz``. An integer decimation (1, q) where one exists (:func:`decimation_factor`);
+    else the smallest such rate with down <= MAX_RESAMPLE_DOWN, if it saves at least
+    MIN_RESAMPLE_SAVING (500 Hz with a 25 Hz filter: (2, 3), 333 Hz); else (1, 1)."""
+    q = decimation_factor(fs, cutoff_hz, rate_per_cutoff)
+    if q > 1 or cutoff_hz is None or not cutoff_hz > 0:
+        return 1, q
+    need = rate_per_cutoff * cutoff_hz
+    best = (1, 1)
+    for down in range(2, MAX_RESAMPLE_DOWN + 1):
+        up = int(np.ceil(need * down / fs - 1e-9))
+        if 0 < up < down and fs * up / down < fs * best[0] / best[1]:
+            best = (up, down) if np.gcd(up, down) == 1 else best
+    return best if best[1] >= MIN_RESAMPLE_SAVING * best[0] else (1, 1)
+
+
 #: Anti-alias low-pass before keeping every q-th sample: zero-phase Butterworth of this order
 #: at this fraction of the new Nyquist frequency (gain 1 - 1e-10 below 0.2 x that frequency).
 ANTIALIAS_ORDER = 8
@@ -174,6 +198,35 @@ def decimate_recording(df: pd.DataFrame, q: int) -> pd.DataFrame:
     fs = 1.0 / uniform_step(t)
     out = {c: t[::q] if c == "time" else antialias_decimate(df[c].to_numpy(dtype=float), fs, q)
            for c in df.columns}
+    return pd.DataFrame(out, columns=list(df.columns))
+
+
+#: The polyphase FIR of a non-integer resampling: half-length in zero crossings of the new
+#: rate, and its Kaiser window's beta (sines below 0.2 x the new Nyquist frequency come
+#: through with RMS error < 5e-7 of their amplitude, measured at 2/3 and 5/8; scipy's
+#: default, 10 crossings and beta 5, leaves 1e-3).
+RESAMPLE_ZERO_CROSSINGS = 32
+RESAMPLE_KAISER_BETA = 12.0
+
+
+def resample_recording(df: pd.DataFrame, up: int, down: int) -> pd.DataFrame:
+    """A recording at up / down its rate: an integer decimation (up 1) by
+    :func:`decimate_recording`, else every column but time by ``scipy.signal.resample_poly``
+    with the FIR of RESAMPLE_* (the same linear filter on every channel) and time on the new
+    uniform grid from the first sample."""
+    if up == 1:
+        return decimate_recording(df, down)
+    if up < 1 or down <= up:
+        raise ValueError(f"resampling ratio must be up/down < 1, got {up}/{down}")
+    t = df["time"].to_numpy(dtype=float)
+    dt = uniform_step(t)
+    fir = signal.firwin(2 * RESAMPLE_ZERO_CROSSINGS * down + 1, 1.0 / down,
+                        window=("kaiser", RESAMPLE_KAISER_BETA))
+    out = {c: signal.resample_poly(df[c].to_numpy(dtype=float), up, down, window=fir,
+                                   padtype="line")
+           for c in df.columns if c != "time"}
+    n = len(next(iter(out.values())))
+    out["time"] = t[0] + np.arange(n) * dt * down / up
     return pd.DataFrame(out, columns=list(df.columns))
 
 

@@ -34,7 +34,7 @@ from harvester.identify import make_problem, posterior_theta
 from harvester.likelihood import Problem
 from harvester.posterior import parameter_names as idata_parameter_names
 from harvester.priors import PriorSpec
-from harvester.signals import decimate_recording, decimation_factor, uniform_step
+from harvester.signals import resample_recording, resampling_ratio, uniform_step
 from harvester.structures import ModelStructure, structure as named_structure
 from harvester.tmcmc import log_evidence as idata_log_evidence
 
@@ -199,21 +199,23 @@ def resample_for_model(rec: pd.DataFrame, validation: pd.DataFrame | None, dt: f
                        ) -> tuple[pd.DataFrame, pd.DataFrame | None, float, list[str]]:
     """(recording, validation, dt, notes) at the rate the model is simulated: a recording
     low-passed at ``lowpass_hz`` and sampled faster than ``signals.RATE_PER_CUTOFF`` x that
-    is decimated (``signals.decimate_recording``; 1024 Hz with a 20 Hz filter -> 256 Hz).
-    The validation record, at the same rate, is decimated alike."""
-    q = decimation_factor(1.0 / dt, lowpass_hz)
-    if q == 1:
+    is resampled (``signals.resampling_ratio``; 1024 Hz with a 20 Hz filter -> 256 Hz, 500 Hz
+    with a 25 Hz filter -> 333 Hz). The validation record, at the same rate, is resampled
+    alike."""
+    up, down = resampling_ratio(1.0 / dt, lowpass_hz)
+    if up == down:
         return rec, validation, dt, []
     if validation is not None:
         dt_v = uniform_step(validation["time"].to_numpy(dtype=float), "<validation>")
         if abs(dt_v - dt) > 1e-6 * dt:
             raise DataError("<validation>", f"sampled every {dt_v:.9g} s, the recording every "
                             f"{dt:.9g} s: give both at the same rate", column="time")
-        validation = decimate_recording(validation, q)
-    note = (f"recording resampled from {1.0 / dt:.0f} Hz to {1.0 / (q * dt):.0f} Hz "
+        validation = resample_recording(validation, up, down)
+    new_dt = dt * down / up
+    note = (f"recording resampled from {1.0 / dt:.4g} Hz to {1.0 / new_dt:.4g} Hz "
             f"(low-pass at {lowpass_hz:.1f} Hz)")
     log.info(note)
-    return decimate_recording(rec, q), validation, q * dt, [note]
+    return resample_recording(rec, up, down), validation, new_dt, [note]
 
 
 def _posterior_samples(idata: az.InferenceData, names: tuple[str, ...]) -> np.ndarray:

@@ -36,6 +36,7 @@ class MotionScale:
     v: float  # RMS velocity (m/s)
     z_quantiles: dict[float, float]  # quantiles of |z| (m)
     f_high: float  # upper edge of the analysed band (Hz)
+    force: float | None = None  # dissipative force scale c_eq v (N), :func:`dissipative_force`
 
 
 #: A grid of shape values (dict parameter -> value) from the motion scale.
@@ -114,16 +115,38 @@ class Signature:
         return self.effect + "(" + ", ".join(f"{k}={v:.3g}" for k, v in self.shape.items()) + ")"
 
 
+def dissipative_force(base_acc: np.ndarray, rel_vel: np.ndarray, m: float) -> float | None:
+    """The damping the motion shows, as a force: c_eq sigma_v (N), with c_eq = <F_d z'> /
+    <z'^2> the equivalent viscous damping of all dissipative forces F_d (viscous, friction,
+    ...) and sigma_v the RMS velocity.
+
+    Eq. (1) times z', averaged: the kinetic and potential energy terms average to their
+    end-point differences over the record, so the power dissipated equals the power the base
+    puts in, <F_d z'> = -m <y'' z'>, whatever the split between viscous damping and friction.
+    A force input F(t) (N, EMPS-like drives) is ``base_acc=F, m=-1``. None when the
+    estimate is not positive (m unknown or 0, or no motion).
+    """
+    v = np.asarray(rel_vel, dtype=float)
+    power = -float(m) * float(np.mean(np.asarray(base_acc, dtype=float) * v))
+    sigma_v = float(np.sqrt(np.mean(v**2)))
+    if not (power > 0.0 and sigma_v > 0.0 and np.isfinite(power)):
+        return None
+    return power / sigma_v
+
+
 def motion_scale(state: BaselineState, window: tuple[int, int], f_high: float) -> MotionScale:
     start, stop = window
     z = state.rel_disp[start:stop]
     v = state.rel_vel[start:stop]
     zc = z - np.median(z)
     az = np.abs(zc)
+    prob = state.problem
+    force = dissipative_force(prob.base_acc[start:stop], v, prob.known.get("m", 0.0)) \
+        if prob.input_kind == "base_acc" else dissipative_force(prob.base_acc[start:stop], v, -1.0)
     return MotionScale(z=float(np.sqrt(np.mean(zc**2))) or 1e-3,
                        v=float(np.sqrt(np.mean(v**2))) or 1e-3,
                        z_quantiles={q: float(np.quantile(az, q)) for q in (0.5, 0.75, 0.9, 0.97)},
-                       f_high=f_high)
+                       f_high=f_high, force=force)
 
 
 def candidate_terms(structure_terms: tuple[str, ...], allowed: tuple[str, ...] | None = None
