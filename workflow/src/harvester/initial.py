@@ -446,8 +446,8 @@ def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
             specs["F_c"] = PriorSpec("F_c", 0.0, float(f_max), unit["F_c"])
         if sigma_v > 0.0:
             specs["beta"] = PriorSpec("beta", 0.0, BETA_SIGMA_V / sigma_v, unit["beta"])
-            log.info("initial modelling: beta lies in 0-%.0f s/m (beta sigma_v up to %g)",
-                     BETA_SIGMA_V / sigma_v, BETA_SIGMA_V)
+            log.info("initial modelling: beta ~ N(0, %.0f s/m) truncated at 0 (beta sigma_v "
+                     "%g per sd)", BETA_SIGMA_V / sigma_v, BETA_SIGMA_V)
     except (DataError, ValueError, np.linalg.LinAlgError) as err:
         log.warning("FRF damping fit failed (%s); c_m, F_c and beta priors are Table 4's", err)
     return {**specs, **stated}
