@@ -6,7 +6,8 @@ the study's Table 1), and may give ``priors`` (``{name: {mean, sd}}``) and ``fil
 (the cut-off of a zero-phase low-pass the recording already went through). The priors of
 c_m and F_c come from the recording's frequency response (``initial.recording_priors``: centred
 on its FRF fit when a static friction is given in ``priors``, else spanning the damping's split
-between the two); beta's is the study's (Table 4). Progress goes to stderr, or to ``--log FILE``.
+between the two), and beta's from the RMS velocity (smooth to sign-law friction). Progress
+goes to stderr, or to ``--log FILE``.
 """
 
 from __future__ import annotations
