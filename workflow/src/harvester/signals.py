@@ -165,12 +165,11 @@ def resampling_ratio(fs: float, cutoff_hz: float | None,
     if q > 1 or cutoff_hz is None or not cutoff_hz > 0:
         return 1, q
     need = rate_per_cutoff * cutoff_hz
-    best = (1, 1)
-    for down in range(2, MAX_RESAMPLE_DOWN + 1):
-        up = int(np.ceil(need * down / fs - 1e-9))
-        if 0 < up < down and fs * up / down < fs * best[0] / best[1]:
-            best = (up, down) if np.gcd(up, down) == 1 else best
-    return best if best[1] >= MIN_RESAMPLE_SAVING * best[0] else (1, 1)
+    ratios = [(int(np.ceil(need * down / fs - 1e-9)), down)
+              for down in range(2, MAX_RESAMPLE_DOWN + 1)]
+    up, down = min(((u, d) for u, d in ratios if u < d), key=lambda r: r[0] / r[1],
+                   default=(1, 1))  # equal ratios: the first, coprime one
+    return (up, down) if down >= MIN_RESAMPLE_SAVING * up else (1, 1)
 
 
 #: Anti-alias low-pass before keeping every q-th sample: zero-phase Butterworth of this order

@@ -230,7 +230,7 @@ def candidate_priors(effect: str, scale: MotionScale, known: Mapping[str, float]
         spec = default_prior(p.name)
         out[p.name] = scaled_prior(spec, ratio[SCALED_BY[p.name]]) if p.name in SCALED_BY \
             else spec
-    force = ratio["force"] * REFERENCE_SCALE["force"]
+    force = scale.force or REFERENCE_SCALE["force"]
     if effect == "backlash":
         contact = backlash_contact_prior(scale.f_high, known or {})
         if contact is not None:

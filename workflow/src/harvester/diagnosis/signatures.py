@@ -141,8 +141,8 @@ def motion_scale(state: BaselineState, window: tuple[int, int], f_high: float) -
     zc = z - np.median(z)
     az = np.abs(zc)
     prob = state.problem
-    force = dissipative_force(prob.base_acc[start:stop], v, prob.known.get("m", 0.0)) \
-        if prob.input_kind == "base_acc" else dissipative_force(prob.base_acc[start:stop], v, -1.0)
+    gain = prob.known.get("m", 0.0) if prob.input_kind == "base_acc" else -1.0  # force input
+    force = dissipative_force(prob.base_acc[start:stop], v, gain)
     return MotionScale(z=float(np.sqrt(np.mean(zc**2))) or 1e-3,
                        v=float(np.sqrt(np.mean(v**2))) or 1e-3,
                        z_quantiles={q: float(np.quantile(az, q)) for q in (0.5, 0.75, 0.9, 0.97)},
