@@ -246,11 +246,12 @@ def filter_artifacts(state: BaselineState, frame: Frame, count: int,
     for i in range(count):
         extra = np.fft.irfft(np.fft.rfft(rng.standard_normal(n_rec)) * amplitude, n=n_rec)
         full = y + extra
-        sims = [problem.simulate(state.theta, base_acc=u) for u in (full, problem.chain(full))]
+        sims = [problem.simulate(state.theta, base_acc=u)
+                for u in (full, problem.recording_filter(full))]
         if not all(s.ok[0] for s in sims):
             out[i] = 0.0
             continue
-        data = problem.chain(problem.chain(sims[0].rel_acc[0]))
+        data = problem.chain(problem.recording_filter(sims[0].rel_acc[0]))
         model = problem.chain(sims[1].rel_acc[0])
         out[i] = frame.dft(data - model)
     return out

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from harvester.diagnosis.baseline import ChainProblem
+from harvester.diagnosis.baseline import ANALYSIS_FRACTION, ChainProblem
 from harvester.predictive import nrmse, outside_fraction, thin
 
 
@@ -50,7 +50,7 @@ def unseen_fit(problem: ChainProblem, samples: np.ndarray, base_acc: np.ndarray,
     record = ChainProblem(problem.structure, base_acc, rel_acc, problem.dt, dict(problem.known),
                           (section[0], section[1]), temper=problem.temper,
                           lowpass_hz=problem.lowpass_hz, filter_order=problem.filter_order,
-                          oversample=problem.oversample)
+                          oversample=problem.oversample, band_fraction=problem.band_fraction)
     pred, ok = record.predicted(theta)
     if not ok.any():
         raise RuntimeError(f"no posterior sample of {problem.structure.name} can be simulated")
@@ -204,6 +204,8 @@ def _diagnosis_dict(d) -> dict:
                     "accepted": rnd.accepted.effect if rnd.accepted else None}
                    for rnd in d.rounds],
         "measurement_chain": {"lowpass_hz": d.lowpass_hz, "filter_order": s.filter_order,
+                              "likelihood_lowpass_hz": None if d.lowpass_hz is None
+                              else ANALYSIS_FRACTION * d.lowpass_hz,
                               "tempering_lambda": d.temper,
                               "analysis_rate_hz": float(1.0 / (d.time[1] - d.time[0]))},
         "analysis_window_s": list(d.window_s),
