@@ -40,9 +40,9 @@ log = logging.getLogger("harvester.diagnosis")
 #: Cut-off of the likelihood's low-pass as a fraction of the recording's. Noise-free records at
 #: the true parameters (40 s, order-8 filters): with the low-pass at the recording's cut-off
 #: the RMS residual was 0.017 and 0.022 m/s^2 on tanh-friction devices with beta sigma_v = 8
-#: and 85 (another simulator, 25 Hz filter) and 0.009 on the study's rig, as large as the
-#: filtered sensor noise (0.016, 0.016, 0.008); at 0.8 it was 0.003, 0.009 and 0.0045, with
-#: the noise 8 % lower.
+#: and 85 (another simulator, 25 Hz filter; filtered sensor noise 0.016) and 0.009 on the
+#: scenario generator's Table 5 device (noise 0.022); at 0.8 it was 0.003, 0.009 and 0.0045,
+#: with the noise 8 % lower.
 ANALYSIS_FRACTION = 0.8
 
 
