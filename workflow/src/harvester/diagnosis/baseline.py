@@ -29,11 +29,12 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import optimize, signal
+from scipy import optimize
 
 from harvester.likelihood import DAQ_OVERSAMPLE, Problem
 from harvester.priors import PriorSpec
 from harvester.pymc_models import priors_for
+from harvester.signals import lowpass
 
 log = logging.getLogger("harvester.diagnosis")
 
@@ -76,9 +77,7 @@ class ChainProblem(Problem):
     def _lowpass(self, x: np.ndarray, cutoff: float | None) -> np.ndarray:
         if cutoff is None:
             return np.asarray(x, dtype=float)
-        sos = signal.butter(self.filter_order, cutoff, btype="low", fs=1.0 / self.dt,
-                            output="sos")
-        return signal.sosfiltfilt(sos, np.asarray(x, dtype=float), axis=-1)
+        return lowpass(x, 1.0 / self.dt, cutoff, self.filter_order)
 
     def chain(self, x: np.ndarray) -> np.ndarray:
         """The likelihood's low-pass (``band_hz``) along the last axis (identity if None)."""

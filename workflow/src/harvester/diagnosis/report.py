@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from harvester.diagnosis.baseline import ANALYSIS_FRACTION, ChainProblem
+from harvester.diagnosis.baseline import ChainProblem
 from harvester.predictive import nrmse, outside_fraction, thin
 
 
@@ -204,8 +204,7 @@ def _diagnosis_dict(d) -> dict:
                     "accepted": rnd.accepted.effect if rnd.accepted else None}
                    for rnd in d.rounds],
         "measurement_chain": {"lowpass_hz": d.lowpass_hz, "filter_order": s.filter_order,
-                              "likelihood_lowpass_hz": None if d.lowpass_hz is None
-                              else ANALYSIS_FRACTION * d.lowpass_hz,
+                              "likelihood_lowpass_hz": d.likelihood_lowpass_hz,
                               "tempering_lambda": d.temper,
                               "analysis_rate_hz": float(1.0 / (d.time[1] - d.time[0]))},
         "analysis_window_s": list(d.window_s),

@@ -147,6 +147,7 @@ class Diagnosis:
     unseen_after: UnseenFit | None
     temper: float
     lowpass_hz: float | None
+    likelihood_lowpass_hz: float | None
     window_s: tuple[float, float]
     fit_window_s: tuple[float, float]
     settings: DiagnosisSettings
@@ -441,6 +442,7 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
         baseline_log_evidence=(baseline_fit.log_evidence if baseline_fit else base_ev),
         baseline_evidence_source=("diagnosis" if baseline_fit else ev_source),
         unseen_before=before, unseen_after=after, temper=temper, lowpass_hz=lowpass,
+        likelihood_lowpass_hz=det_problem.band_hz,
         window_s=(float(t[lead]), float(t[hold - 1])),
         fit_window_s=(float(t[lead]), float(t[fit_stop - 1])), settings=settings,
         priors=specs, seconds=time.perf_counter() - clock, time=t, notes=notes)
