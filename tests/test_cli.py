@@ -104,8 +104,9 @@ def test_cli_end_to_end_writes_diagnosis_json(recording, tmp_path, capsys):
     assert d["verdict"] == "missing_physics"
     for c in d["candidates"]:
         assert isinstance(c["effect"], str)
-        for key in ("log_evidence", "delta_log_evidence"):
+        for key in ("log_evidence", "delta_log_evidence", "log_evidence_tmcmc"):
             assert isinstance(c[key], float)
+        assert c["log_evidence_method"] in ("bridge", "tmcmc")
         for stats in c["parameters"].values():
             assert isinstance(stats["mean"], float) and isinstance(stats["sd"], float)
     loc = d["locations"]
