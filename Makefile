@@ -30,6 +30,7 @@ test-slow: $(STAMP)
 benchmark: $(STAMP)
 	$(BIN)/python benchmarks/bench_tmcmc.py
 	$(BIN)/python benchmarks/bench_resampling.py
+	$(BIN)/python benchmarks/bench_evidence.py
 
 detection: $(STAMP)
 	$(BIN)/snakemake --cores $(CORES) detection_all

@@ -98,3 +98,36 @@ def test_detection_power_on_an_inertia_error_at_the_noise_rms():
     seeds; at the noise RMS (0.21-0.26 x left) 3 of 4, at twice it 4 of 4 (measured)."""
     found = detected("inertia_error", 1.0)
     assert sum(found) >= 3, f"inertia_error: detected in {sum(found)} of 4"
+
+
+def test_evidence_acceptance_on_forced_candidates_at_most_5_percent():
+    """The acceptance rule alone, with the screen bypassed: on 8 records of the tanh baseline,
+    Coulomb and Stribeck friction (nested around the baseline's friction: the hardest to
+    reject) are sampled on every record and compared by bridge-sampling evidence, whose
+    standard error sets a lower threshold than TMCMC's chain scatter did. Markov's bound
+    (``confirm``) allows 5 %; at most one acceptance of the 16 comparisons passes."""
+    from harvester.diagnosis.baseline import baseline_state, chain_problem, fit_map
+    from harvester.diagnosis.confirm import ConfirmSettings, confirm, fit_structure
+    from harvester.diagnosis.detect import estimate_temper
+    from harvester.diagnosis.run import default_priors
+    from harvester.diagnosis.signatures import motion_scale
+    from harvester.identify import make_problem
+    from harvester.structures import structure
+
+    effects = ["coulomb_friction", "stribeck_friction"]
+    accepted, deltas = 0, []
+    for seed in range(8):
+        rec = null_recording(seed, 12.0)
+        raw = make_problem(rec, "tanh", TABLE1_KNOWN, window=(256, len(rec) - 128))
+        mp = fit_map(chain_problem(raw, 1.0, 20.0, 8), PRIORS, seed=seed)
+        temper = estimate_temper(mp.residual, raw.window, 256.0, 18.0)
+        problem = chain_problem(raw, temper, 20.0, 8)
+        specs = {**default_priors(structure("tanh"), float(mp.theta[-1])), **PRIORS}
+        cs = ConfirmSettings(particles=100, chains=2, seed=seed)
+        base = fit_structure(problem, structure("tanh"), specs, cs)
+        scale = motion_scale(baseline_state(problem, base.samples), raw.window, 18.0)
+        results = confirm(base, effects, specs, cs, scale, seed_offset=100)
+        accepted += sum(r.accepted for r in results)
+        deltas += [round(r.delta_log_evidence, 2) for r in results]
+    print("delta log evidence of forced candidates:", deltas)
+    assert accepted <= 1, f"{accepted} accepted of {len(deltas)}"
