@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from scipy import integrate, stats
 
-from harvester.evidence import bridge_log_evidence, effective_count
+from harvester.evidence import (bridge_log_evidence, chains_bridge_log_evidence,
+                                effective_count)
 
 
 def linear_gaussian(seed: int, d: int = 4, n: int = 40, s0: float = 2.0, noise: float = 0.5):
@@ -67,6 +68,24 @@ def test_a_posterior_piled_against_a_prior_bound():
     samples = post.rvs(size=(400, 1), random_state=rng)
     est = bridge_log_evidence(log_target, samples, rng)
     assert abs(est.log_evidence - exact) < max(4 * est.se, 0.05)
+
+
+def test_chains_that_disagree_widen_the_stated_error():
+    """Two chains, one of whose populations has not settled (drawn from a posterior too
+    narrow): the pooled estimate's error is at least the chains' scatter over sqrt(2), and
+    wider than the formula's alone."""
+    log_target, log_z, mean, cov = linear_gaussian(7)
+    rng = np.random.default_rng(11)
+    good = resampled_posterior(rng, mean, cov)
+    narrow = resampled_posterior(rng, mean, 0.3 * cov)
+    est = chains_bridge_log_evidence(log_target, [good, narrow], rng)
+    a, b = est.chain_log_evidence
+    assert est.se >= abs(a - b) / 2 - 1e-12
+    assert est.se > 3 * est.formula_se
+    # settled chains: the formula's error stands
+    fine = chains_bridge_log_evidence(
+        log_target, [resampled_posterior(rng, mean, cov) for _ in range(2)], rng)
+    assert abs(fine.log_evidence - log_z) < 4 * fine.se
 
 
 def test_the_effective_count_discounts_duplicates():

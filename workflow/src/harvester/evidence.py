@@ -13,13 +13,15 @@ q a Gaussian fitted to the posterior samples, alpha the optimal bridge function
 It needs N2 more likelihood evaluations (draws from q), fewer than one TMCMC stage, and its
 relative mean squared error (Fruhwirth-Schnatter 2004, eq. 15; Gronau et al. 2017) is
 estimated from the same evaluations, the posterior samples' share counted by their
-effective number (resampled populations hold duplicates).
+effective number (resampled populations hold duplicates). With several chains the error is
+also read off the chains' own estimates (``chains_bridge_log_evidence``): the formula trusts
+the population to be a posterior sample, which a short TMCMC run need not give.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.special import logsumexp
@@ -33,7 +35,9 @@ TOL = 1e-10
 
 @dataclass(frozen=True)
 class BridgeEstimate:
-    """log Z with its standard error (nats, from the relative MSE) and what it used."""
+    """log Z with its standard error (nats) and what it used: ``formula_se`` from the relative
+    MSE; with several chains, ``chain_log_evidence`` holds each chain's own estimate and
+    ``se`` is the larger of the formula's and the chains' scatter over sqrt(chains)."""
 
     log_evidence: float
     se: float
@@ -41,9 +45,13 @@ class BridgeEstimate:
     n_effective: float
     n_proposal: int
     iterations: int
+    formula_se: float = float("nan")
+    chain_log_evidence: tuple[float, ...] = ()
 
-    def to_dict(self) -> dict[str, float]:
+    def to_dict(self) -> dict:
         return {"log_evidence": self.log_evidence, "se": self.se,
+                "formula_se": self.formula_se,
+                "chain_log_evidence": list(self.chain_log_evidence),
                 "n_posterior": self.n_posterior, "n_effective": self.n_effective,
                 "n_proposal": self.n_proposal}
 
@@ -151,7 +159,30 @@ def bridge_log_evidence(log_target: Callable[[np.ndarray], np.ndarray], samples:
     log_z, iterations = bridge_iterate(l1, l2)
     n_eff = effective_count(x)
     se = float(np.sqrt(max(relative_mse(l1, l2, log_z, n_eff), 0.0)))
-    return BridgeEstimate(log_z, se, len(x), n_eff, n2, iterations)
+    return BridgeEstimate(log_z, se, len(x), n_eff, n2, iterations, formula_se=se)
+
+
+def chains_bridge_log_evidence(log_target: Callable[[np.ndarray], np.ndarray],
+                               chains: Sequence[np.ndarray], rng: np.random.Generator
+                               ) -> BridgeEstimate:
+    """The bridge estimate from the pooled chains, its error checked against the chains'.
+
+    The relative MSE assumes the rows are draws from the posterior; a population that has
+    not settled (few particles, few Metropolis moves, a posterior piled against a bound)
+    breaks that, and the formula then understates the error (measured: per-chain estimates
+    scattering by 0.9 nats with a stated 0.08, 4 chains of 150 particles of the tanh model
+    with Coulomb friction). Each chain is estimated on its own as well, and ``se`` is the
+    larger of the pooled formula's and sd(chain estimates) / sqrt(chains).
+    """
+    pooled = bridge_log_evidence(log_target, np.vstack(chains), rng)
+    own = []
+    for rows in chains if len(chains) > 1 else []:
+        try:
+            own.append(bridge_log_evidence(log_target, rows, rng).log_evidence)
+        except (ValueError, np.linalg.LinAlgError):
+            continue
+    scatter = float(np.std(own, ddof=1) / np.sqrt(len(own))) if len(own) > 1 else 0.0
+    return replace(pooled, se=max(pooled.formula_se, scatter), chain_log_evidence=tuple(own))
 
 
 def log_target(loglike: Callable[[np.ndarray], np.ndarray], priors: Sequence[PriorSpec]

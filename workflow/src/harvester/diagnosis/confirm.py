@@ -46,7 +46,7 @@ import numpy as np
 
 from harvester.diagnosis.baseline import ChainProblem, chain_problem
 from harvester.diagnosis.signatures import MotionScale
-from harvester.evidence import BridgeEstimate, bridge_log_evidence, log_target
+from harvester.evidence import BridgeEstimate, chains_bridge_log_evidence, log_target
 from harvester.identify import TMCMCSettings, identify, posterior_theta
 from harvester.physics import term
 from harvester.posterior import pooled_log_evidence
@@ -314,16 +314,18 @@ def fit_structure(problem: ChainProblem, structure: ModelStructure,
 def bridge_evidence(problem: ChainProblem, priors: Mapping[str, PriorSpec],
                     samples: np.ndarray, chain_evidence: np.ndarray, seed: int
                     ) -> BridgeEstimate | None:
-    """Bridge-sampling log evidence (``harvester.evidence``) from the posterior samples of the
-    chains that found the main mode (TMCMC evidence within MISSED_MODE_NATS of the best: a
-    chain stuck in a minor mode holds samples of the wrong weight); None where it fails."""
+    """Bridge-sampling log evidence (``harvester.evidence.chains_bridge_log_evidence``) from
+    the posterior samples of the chains that found the main mode (TMCMC evidence within
+    MISSED_MODE_NATS of the best: a chain stuck in a minor mode holds samples of the wrong
+    weight); its error is the larger of the formula's and the chains' scatter. None where it
+    fails."""
     chains = len(chain_evidence)
     rows = np.split(samples, chains) if chains > 1 else [samples]
     keep = [r for r, e in zip(rows, chain_evidence)
             if e >= np.max(chain_evidence) - MISSED_MODE_NATS]
     target = log_target(problem.loglike, [priors[n] for n in problem.parameter_names])
     try:
-        return bridge_log_evidence(target, np.vstack(keep), np.random.default_rng(seed))
+        return chains_bridge_log_evidence(target, keep, np.random.default_rng(seed))
     except (ValueError, np.linalg.LinAlgError) as err:
         log.warning("bridge sampling failed (%s); TMCMC's evidence is used", err)
         return None
