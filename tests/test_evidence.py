@@ -88,6 +88,19 @@ def test_chains_that_disagree_widen_the_stated_error():
     assert abs(fine.log_evidence - log_z) < 4 * fine.se
 
 
+def test_a_chain_that_missed_the_mode_is_left_out():
+    """A chain whose population sits far from the posterior's mass (stuck in a minor mode)
+    estimates a far smaller evidence on its own; it is left out and the others' pooled
+    estimate stands."""
+    log_target, log_z, mean, cov = linear_gaussian(9)
+    rng = np.random.default_rng(5)
+    good = [resampled_posterior(rng, mean, cov) for _ in range(2)]
+    stuck = resampled_posterior(rng, mean + 8.0 * np.sqrt(np.diag(cov)), 0.2 * cov)
+    est = chains_bridge_log_evidence(log_target, [*good, stuck], rng, missed_mode_nats=5.0)
+    assert len(est.chain_log_evidence) == 2
+    assert abs(est.log_evidence - log_z) < 4 * est.se
+
+
 def test_the_effective_count_discounts_duplicates():
     x = np.repeat(np.arange(10.0)[:, None], 3, axis=0)
     assert effective_count(x) == pytest.approx(10.0)

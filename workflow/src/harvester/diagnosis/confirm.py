@@ -111,12 +111,11 @@ class ModelFit:
     log_evidence_chains: np.ndarray
     idata: az.InferenceData | None = field(default=None, repr=False)
     priors: dict[str, PriorSpec] = field(default_factory=dict, repr=False)
+    bridge: BridgeEstimate | None = None
 
     @property
     def names(self) -> tuple[str, ...]:
         return self.problem.parameter_names
-
-    bridge: BridgeEstimate | None = None
 
     @property
     def log_evidence(self) -> float:
@@ -315,17 +314,17 @@ def bridge_evidence(problem: ChainProblem, priors: Mapping[str, PriorSpec],
                     samples: np.ndarray, chain_evidence: np.ndarray, seed: int
                     ) -> BridgeEstimate | None:
     """Bridge-sampling log evidence (``harvester.evidence.chains_bridge_log_evidence``) from
-    the posterior samples of the chains that found the main mode (TMCMC evidence within
-    MISSED_MODE_NATS of the best: a chain stuck in a minor mode holds samples of the wrong
-    weight); its error is the larger of the formula's and the chains' scatter. None where it
-    fails."""
+    the posterior samples of the chains whose own bridge estimate lies within
+    MISSED_MODE_NATS of the best chain's (a chain stuck in a minor mode holds samples of the
+    wrong weight; TMCMC's own chain estimates scatter by up to 6 nats without that, so they
+    do not decide it); its error is the larger of the formula's and the chains' scatter.
+    None where it fails."""
     chains = len(chain_evidence)
     rows = np.split(samples, chains) if chains > 1 else [samples]
-    keep = [r for r, e in zip(rows, chain_evidence)
-            if e >= np.max(chain_evidence) - MISSED_MODE_NATS]
     target = log_target(problem.loglike, [priors[n] for n in problem.parameter_names])
     try:
-        return chains_bridge_log_evidence(target, keep, np.random.default_rng(seed))
+        return chains_bridge_log_evidence(target, rows, np.random.default_rng(seed),
+                                          MISSED_MODE_NATS)
     except (ValueError, np.linalg.LinAlgError) as err:
         log.warning("bridge sampling failed (%s); TMCMC's evidence is used", err)
         return None
