@@ -239,3 +239,63 @@ def test_tied_counts_an_effect_reported_indistinguishable_from_the_first():
     table = det.detection_table(rows).set_index("effect")
     assert table.loc["coulomb_friction", "tied_rate"] == 1.0
     assert table.loc["end_stop", "tied_rate"] == 0.0
+
+
+def _informed(diagnosis, lam=0.1, window=(1.0, 16.0), rate=256.0, alpha=0.05):
+    return {**diagnosis, "measurement_chain": {"tempering_lambda": lam, "analysis_rate_hz": rate},
+            "tmcmc_window_s": list(window), "settings": {"evidence_alpha": alpha}}
+
+
+def test_information_is_the_tempered_likelihood_gain_of_what_the_baseline_leaves():
+    truth = {**_truth("inertia_error", 0.5, 0), "unabsorbed_to_noise": 0.12}
+    diag = _informed(_diag())
+    n = 15 * 256 + 1
+    assert det.information_nats(truth, diag) == pytest.approx(0.5 * 0.1 * n * 0.12**2)
+    assert det.acceptance_nats(diag) == pytest.approx(np.log(20.0))
+    assert det.acceptance_nats(_informed(_diag(), alpha=0.01)) == pytest.approx(np.log(100.0))
+    # unknown lambda or window: NaN, and the scenario counts as nameable (the plain rate)
+    assert np.isnan(det.information_nats(truth, _diag()))
+    rows = det.results_table([
+        (truth, diag),                                                         # 2.8 nats
+        ({**_truth("end_stop", 0.5, 0), "unabsorbed_to_noise": 0.5}, _informed(_diag("end_stop"))),
+        (_truth("end_stop", 0.5, 1), _diag("cubic_stiffness")),                # not known
+        (_truth("none_tanh", 0.0, 0), _informed(_diag())),
+    ]).set_index(["effect", "seed"])
+    assert not rows.loc[("inertia_error", 0), "nameable"]
+    assert rows.loc[("end_stop", 0), "nameable"] and rows.loc[("end_stop", 1), "nameable"]
+    assert rows.loc[("end_stop", 0), "information_nats"] == pytest.approx(0.5 * 0.1 * n * 0.25)
+    assert not rows.loc[("none_tanh", 0), "nameable"]  # effect-free: nothing to name
+
+
+def test_goal_summary_pools_effects_and_separates_the_nameable():
+    def pair(effect, seed, u, *missing, tie=None):
+        d = _informed(_diag(*missing))
+        if tie:
+            d["indistinguishable"] = [tie]
+        return {**_truth(effect, 0.5, seed), "unabsorbed_to_noise": u}, d
+
+    rows = det.results_table([
+        pair("end_stop", 0, 0.5, "end_stop"),
+        pair("end_stop", 1, 0.5, "cubic_stiffness", "end_stop",
+             tie=["cubic_stiffness", "end_stop"]),
+        pair("quadratic_damping", 0, 0.03),                        # adequate, 0.17 nats
+        pair("inertia_error", 0, 0.12),                            # adequate, 2.8 nats
+        ({**_truth("none_tanh", 0.0, 0)}, _informed(_diag())),
+    ])
+    s = det.goal_summary(rows).set_index("ratio").loc[0.5]
+    assert (s["scenarios"], s["named"], s["tied"]) == (4, 1, 2)
+    assert (s["nameable"], s["named_nameable"], s["tied_nameable"]) == (2, 1, 2)
+    assert s["named_rate_nameable"] == 0.5 and s["named_rate"] == 0.25
+    assert s["not_nameable"] == "inertia_error, quadratic_damping"
+    assert s["named_nameable_lo"] < 0.5 < s["named_nameable_hi"]
+    assert not s["meets_goal"] and not s["meets_goal_nameable"]
+    table = det.detection_table(rows).set_index("effect")
+    assert (table.loc["end_stop", "nameable"], table.loc["end_stop", "named_nameable"]) == (2, 1)
+    assert table.loc["quadratic_damping", "nameable"] == 0
+
+
+def test_figure_with_the_information_panel(results, tmp_path):
+    rows = results.assign(information_nats=np.linspace(0.1, 80.0, len(results)))
+    path = tmp_path / "rates.png"
+    det.detection_figure(det.detection_table(rows), det.false_alarms(rows), path, results=rows)
+    assert path.stat().st_size > 20_000

@@ -19,6 +19,8 @@ from pytensor.graph.replace import vectorize_graph
 from scipy.stats import multivariate_normal
 
 from harvester.batched import BatchedLogLike, loglike_potential
+from harvester.priors import PriorSpec
+from harvester.reference import GaussianFactor, Reference, ScanFactor
 from harvester.tmcmc import (
     TMCMC,
     TMCMCError,
@@ -314,3 +316,158 @@ def test_log_evidence_linear_gaussian_spread_over_many_seeds(linear_gaussian):
     errors = log_evidence(run_tmcmc(model, draws=1000, chains=60, seed=99)) - exact
     assert abs(errors.mean()) < 3 * errors.std() / np.sqrt(len(errors)) + 0.05
     assert errors.std() < 0.6
+
+
+# --------------------------------------------------------------------------------------------
+# Tempering from a reference distribution
+# --------------------------------------------------------------------------------------------
+
+#: A resonance's evidence in miniature: log L = G k(x) (1 - (m / m0 - 1)^2), k(x) a narrow
+#: bump at the frequency x0; away from it the likelihood is flat (the baseline's), and at it a
+#: parabola in the modal mass m. Few prior draws of x land on the bump.
+PEAK = {"gain": 24.0, "x0": 6.57, "s": 0.03, "m0": 0.22}
+PRIOR_X = {"mu": 8.0, "sigma": 6.0, "lower": 0.5}
+PRIOR_M = {"mu": 0.5, "sigma": 0.5, "lower": 0.0}
+
+
+def _peak_model():
+    with pm.Model() as model:
+        x = pm.TruncatedNormal("x", **PRIOR_X)
+        m = pm.TruncatedNormal("m", **PRIOR_M)
+        bump = pt.exp(-0.5 * ((x - PEAK["x0"]) / PEAK["s"]) ** 2)
+        pm.Potential("peak", PEAK["gain"] * bump * (1.0 - (m / PEAK["m0"] - 1.0) ** 2))
+    return model
+
+
+def _peak_exact_log_evidence() -> float:
+    """log(1 + E_prior[L - 1]) by quadrature on a fine grid over the bump (L = 1 elsewhere)."""
+    from scipy import stats
+
+    def prior(p, v):
+        return stats.truncnorm.pdf(v, (p["lower"] - p["mu"]) / p["sigma"], np.inf,
+                                   loc=p["mu"], scale=p["sigma"])
+
+    x = np.linspace(PEAK["x0"] - 9 * PEAK["s"], PEAK["x0"] + 9 * PEAK["s"], 3001)
+    m = np.linspace(0.0, 6.0, 6001)
+    k = np.exp(-0.5 * ((x - PEAK["x0"]) / PEAK["s"]) ** 2)[:, None]
+    q = (1.0 - (m / PEAK["m0"] - 1.0) ** 2)[None, :]
+    excess = np.expm1(PEAK["gain"] * k * q) * prior(PRIOR_X, x)[:, None] * prior(PRIOR_M, m)
+    return float(np.log1p(np.trapezoid(np.trapezoid(excess, m, axis=1), x)))
+
+
+def _prior(p, name="x"):
+    return PriorSpec(name, p["mu"], p["sigma"], "-", p["lower"])
+
+
+def _reference(centres=(6.2, 7.4), weights=(0.6, 0.4), share=0.5, gaussian=None):
+    factors = [ScanFactor("x", centres, (np.log(1.2),) * len(centres), weights, PRIOR_X["lower"])]
+    if gaussian is not None:
+        factors.append(gaussian)
+    return Reference({"x": _prior(PRIOR_X), "m": _prior(PRIOR_M, "m")}, tuple(factors), share)
+
+
+def _quad(f, lo, hi, points=None):
+    from scipy import integrate
+
+    return integrate.quad(lambda v: float(f(np.array([v]))[0]), lo, hi, points=points,
+                          limit=400)[0]
+
+
+def test_reference_densities_are_normalised_and_draws_follow_them():
+    ref = _reference()
+    scan = ref.factors[0]
+    assert _quad(lambda v: np.exp(scan.log_density(v)), 0.5, 80, [6.2, 7.4]) == \
+        pytest.approx(1.0, abs=1e-6)
+    assert _quad(lambda v: np.exp(_prior(PRIOR_X).logpdf(v)), 0.5, 80) == \
+        pytest.approx(1.0, abs=1e-6)
+    # q = prior x ratio is a density, and the ratio never falls below 1 - share
+    q = _quad(lambda v: np.exp(_prior(PRIOR_X).logpdf(v) + ref.log_ratio(v[:, None])),
+              0.5, 80, [6.2, 7.4])
+    assert q == pytest.approx(1.0, abs=1e-6)
+    assert np.all(ref.log_ratio(np.linspace(0.6, 40, 200)[:, None]) >= np.log(0.5) - 1e-12)
+    draws = ref.draw(np.random.default_rng(1), 20_000)[:, 0]
+    assert draws.min() > 0.5
+    expected = _quad(lambda v: np.exp(scan.log_density(v)), 5.0, 7.0)
+    assert np.mean((draws > 5.0) & (draws < 7.0)) == pytest.approx(expected, abs=0.015)
+    # a Gaussian factor cut by the support is normalised over the support
+    g = GaussianFactor(("m",), (0.1,), ((0.04,),), (0.0,))
+    assert _quad(lambda v: np.exp(g.log_density(v[:, None])), 0.0, 3.0) == \
+        pytest.approx(1.0, abs=2e-3)
+    assert g.draw(np.random.default_rng(2), 1000).min() >= 0.0
+    with pytest.raises(ValueError, match="share"):
+        _reference(share=1.0)
+    with pytest.raises(ValueError, match="lower bound"):
+        _reference(centres=(0.2,), weights=(1.0,))
+    with pytest.raises(ValueError, match="distinct"):
+        _reference(gaussian=GaussianFactor(("x",), (5.0,), ((1.0,),), (0.5,)))
+
+
+def _peak_loglike(theta: np.ndarray) -> np.ndarray:
+    x, m = theta[:, 0], theta[:, 1]
+    bump = np.exp(-0.5 * ((x - PEAK["x0"]) / PEAK["s"]) ** 2)
+    return PEAK["gain"] * bump * (1.0 - (m / PEAK["m0"] - 1.0) ** 2)
+
+
+def test_reference_finds_a_narrow_peak_the_prior_misses_and_keeps_the_evidence_exact():
+    """As the diagnosis uses it: TMCMC from the reference, then the bridge estimate from its
+    final population (harvester.evidence)."""
+    from harvester.evidence import chains_bridge_log_evidence, log_target
+
+    model = _peak_model()
+    exact = _peak_exact_log_evidence()
+    assert exact > 10.0  # the peak dominates the evidence
+    settings = dict(draws=300, chains=2, seed=3, mcmc_steps=3, proposal_scale=0.8)
+    prior_start = log_evidence(run_tmcmc(model, **settings))
+    assert np.all(prior_start < exact - 10.0)  # both chains missed the peak: why it exists
+    idata = run_tmcmc(model, **settings, reference=_reference())
+    post = idata.posterior
+    assert float(post["x"].mean()) == pytest.approx(PEAK["x0"], abs=0.02)
+    assert float(post["m"].mean()) == pytest.approx(PEAK["m0"], abs=0.03)
+    assert np.all(log_evidence(idata) > exact - 6.0)
+    target = log_target(_peak_loglike, [_prior(PRIOR_X), _prior(PRIOR_M, "m")])
+    rows = [np.column_stack([post["x"].values[c], post["m"].values[c]]) for c in range(2)]
+    bridge = chains_bridge_log_evidence(target, rows, np.random.default_rng(0))
+    assert bridge.log_evidence == pytest.approx(exact, abs=max(0.3, 3 * bridge.se))
+
+
+def test_reference_path_keeps_a_conjugate_evidence_exact_over_seeds():
+    """Normal means with truncated priors; both factors of the reference placed off the
+    posterior, so the evidence must come right through the weights, not the placement."""
+    from scipy import integrate, stats
+
+    y = np.array([4.1, 3.6, 4.4, 3.9])
+    u = np.array([0.9, 1.3])
+    with pm.Model() as model:
+        x = pm.TruncatedNormal("x", **PRIOR_X)
+        m = pm.TruncatedNormal("m", **PRIOR_M)
+        pm.Normal("y", x, 0.5, observed=y)
+        pm.Normal("u", m, 0.3, observed=u)
+    prior = stats.truncnorm((PRIOR_X["lower"] - PRIOR_X["mu"]) / PRIOR_X["sigma"], np.inf,
+                            loc=PRIOR_X["mu"], scale=PRIOR_X["sigma"])
+    prior_m = stats.truncnorm((PRIOR_M["lower"] - PRIOR_M["mu"]) / PRIOR_M["sigma"], np.inf,
+                              loc=PRIOR_M["mu"], scale=PRIOR_M["sigma"])
+    exact = np.log(integrate.quad(
+        lambda v: prior.pdf(v) * np.prod(stats.norm.pdf(y, v, 0.5)), 0.5, 30, points=[4.0])[0])
+    exact += np.log(integrate.quad(
+        lambda v: prior_m.pdf(v) * np.prod(stats.norm.pdf(u, v, 0.3)), 0.0, 6, points=[1.1])[0])
+    off = GaussianFactor(("m",), (0.6,), ((0.05,),), (0.0,))  # posterior: about 1.0 +- 0.2
+    ev = log_evidence(run_tmcmc(model, draws=400, chains=12, seed=5, mcmc_steps=3,
+                                proposal_scale=0.8,
+                                reference=_reference((2.0, 9.0), (0.5, 0.5), gaussian=off)))
+    err = ev - exact
+    assert abs(err.mean()) < 3 * err.std() / np.sqrt(len(err)) + 0.03
+    assert err.std() < 0.2
+
+
+def test_without_a_reference_the_path_is_unchanged(linear_gaussian):
+    model, _ = linear_gaussian
+    a = run_tmcmc(model, draws=200, chains=1, seed=11)
+    b = run_tmcmc(model, draws=200, chains=1, seed=11, reference=None)
+    assert np.array_equal(log_evidence(a), log_evidence(b))
+    assert np.array_equal(a.posterior["w"].values, b.posterior["w"].values)
+
+
+def test_reference_needs_a_scalar_free_variable_of_the_model(linear_gaussian):
+    model, _ = linear_gaussian
+    with pytest.raises(ValueError, match="not in the model"):
+        run_tmcmc(model, draws=50, chains=1, seed=0, reference=_reference())

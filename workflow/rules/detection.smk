@@ -45,6 +45,7 @@ rule detection_all:
         f"{DET}/detection_table.csv",
         f"{DET}/confusion_matrix.csv",
         f"{DET}/false_alarms.csv",
+        f"{DET}/goal_summary.csv",
         f"{DET}/figures/detection_rates.png",
 
 
@@ -105,6 +106,8 @@ rule detection_table:
                          category="Concealed effects"),
         alarms=report(f"{DET}/false_alarms.csv", caption="../report/detection_false_alarms.rst",
                       category="Concealed effects"),
+        summary=report(f"{DET}/goal_summary.csv", caption="../report/detection_summary.rst",
+                       category="Concealed effects"),
     params:
         accepted=lambda w: DETECTION.get("accepted", {}),
         goal=lambda w: DETECTION["goal"],
@@ -120,6 +123,7 @@ rule detection_figure:
     input:
         table=f"{DET}/detection_table.csv",
         alarms=f"{DET}/false_alarms.csv",
+        results=f"{DET}/scenario_results.csv",
     output:
         report(f"{DET}/figures/detection_rates.png", caption="../report/detection_rates.rst",
                category="Concealed effects"),

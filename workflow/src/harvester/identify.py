@@ -16,7 +16,7 @@ from harvester.priors import PriorSpec
 from harvester.recording import input_output
 from harvester.pymc_models import build_model
 from harvester.structures import ModelStructure, structure
-from harvester.tmcmc import run_tmcmc
+from harvester.tmcmc import Reference, run_tmcmc
 
 log = logging.getLogger("harvester.identify")
 
@@ -97,15 +97,20 @@ def make_problem(recording: pd.DataFrame, model: str | ModelStructure, known: Ma
 
 
 def identify(problem: Problem, priors: Mapping[str, PriorSpec],
-             settings: TMCMCSettings) -> az.InferenceData:
-    """Posterior samples and log evidence of ``problem`` by TMCMC (ArviZ InferenceData)."""
+             settings: TMCMCSettings, reference: Reference | None = None) -> az.InferenceData:
+    """Posterior samples and log evidence of ``problem`` by TMCMC (ArviZ InferenceData).
+
+    ``reference``: temper from it instead of the prior (``harvester.tmcmc.Reference``); its
+    prior must be the one ``priors`` gives its variable."""
     model = build_model(problem, priors)
+    extra = {} if reference is None else {"reference": reference}
     log.info("TMCMC for %s: parameters %s, %d particles x %d chains, %d data points",
              problem.structure.name, ", ".join(problem.parameter_names), settings.particles,
              settings.chains, problem.n_data)
     idata = run_tmcmc(model, draws=settings.particles, chains=settings.chains, seed=settings.seed,
                       proposal_scale=settings.proposal_scale, target_cov=settings.target_cov,
-                      mcmc_steps=settings.mcmc_steps, target_accept=settings.target_accept)
+                      mcmc_steps=settings.mcmc_steps, target_accept=settings.target_accept,
+                      **extra)
     idata.posterior.attrs["parameter_names"] = ",".join(problem.parameter_names)
     idata.posterior.attrs["model"] = problem.structure.name
     idata.posterior.attrs["terms"] = ",".join(problem.structure.terms)

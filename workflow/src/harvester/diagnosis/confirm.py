@@ -33,6 +33,16 @@ grid. Priors given by the caller always win.
 Particles. A candidate's TMCMC gets ``particles`` x (its added parameters / 2), at least
 ``particles`` (``candidate_particles``): the secondary mode's four parameters hold a narrow
 peak in f_mode that few prior draws hit.
+
+Start. A candidate's TMCMC tempers from a reference distribution, not from the prior
+(``harvester.reference``, ``candidate_reference``): half its initial particles take the
+parameters it shares with the model it extends from that model's posterior (widened), and a
+``Probe.start_shape`` (the secondary mode's frequency) from the detection's scan of it; the
+other half come from the prior, which bounds the importance weights. The prior, the posterior
+and the evidence are unchanged; what changes is that the tempering no longer spends its first
+stages (and their resampling, which thins out every added parameter's values at random)
+re-finding the baseline's parameters, so a narrow peak of an added parameter survives to the
+stages where its likelihood gain counts.
 """
 
 from __future__ import annotations
@@ -45,7 +55,8 @@ import arviz as az
 import numpy as np
 
 from harvester.diagnosis.baseline import ChainProblem, chain_problem
-from harvester.diagnosis.signatures import MotionScale
+from harvester.diagnosis.detect import Detection
+from harvester.diagnosis.signatures import PROBES, MotionScale
 from harvester.evidence import BridgeEstimate, chains_bridge_log_evidence, log_target
 from harvester.identify import TMCMCSettings, identify, posterior_theta
 from harvester.physics import term
@@ -53,6 +64,7 @@ from harvester.posterior import pooled_log_evidence
 from harvester.priors import PriorSpec
 from harvester.pymc_models import default_prior, priors_for
 from harvester.structures import ModelStructure
+from harvester.reference import GaussianFactor, Reference, ScanFactor
 from harvester.tmcmc import log_evidence
 
 log = logging.getLogger("harvester.diagnosis")
@@ -112,6 +124,7 @@ class ModelFit:
     idata: az.InferenceData | None = field(default=None, repr=False)
     priors: dict[str, PriorSpec] = field(default_factory=dict, repr=False)
     bridge: BridgeEstimate | None = None
+    reference: Reference | None = None
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -158,7 +171,8 @@ class ModelFit:
                 "log_evidence_tmcmc": self.tmcmc_log_evidence,
                 "log_evidence_chains": [float(x) for x in self.log_evidence_chains],
                 "chains_missing_the_mode": self.missed_chains,
-                "log_evidence_bridge": self.bridge.to_dict() if self.bridge else None}
+                "log_evidence_bridge": self.bridge.to_dict() if self.bridge else None,
+                "tempered_from": self.reference.describe() if self.reference else None}
 
     def summary(self) -> dict[str, dict[str, float]]:
         return {n: {"mean": float(self.samples[:, j].mean()),
@@ -291,13 +305,83 @@ def candidate_particles(effect: str, particles: int) -> int:
     return int(particles * max(1.0, len(term(effect).parameters) / 2.0))
 
 
+#: Share of a candidate's initial particles drawn from the reference rather than the prior.
+REFERENCE_SHARE = 0.5
+#: The nested model's posterior sds are widened by this factor in the reference.
+REFERENCE_WIDEN = 1.5
+
+
+def candidate_reference(effect: str, nested: ModelFit, detection: Detection | None,
+                        priors: Mapping[str, PriorSpec]) -> Reference | None:
+    """Where a candidate's TMCMC starts half its particles (``harvester.reference``): the
+    parameters it shares with the model it extends at that model's posterior (a Gaussian,
+    sds widened by REFERENCE_WIDEN), and its ``Probe.start_shape`` where the detection's scan
+    places it (:func:`scan_factor`); its other parameters from their priors. ``priors`` must be
+    the ones the candidate's model is built with. None where ``nested`` has no samples."""
+    if nested.samples is None or len(nested.samples) < 2 * len(nested.names):
+        return None
+    lowers = tuple(float(priors[n].lower) for n in nested.names)
+    inside = np.all(nested.samples >= np.asarray(lowers)[None, :], axis=1)
+    try:
+        factors: list = [GaussianFactor.from_samples(tuple(nested.names),
+                                                     nested.samples[inside], lowers,
+                                                     REFERENCE_WIDEN)]
+        scan = scan_factor(effect, detection, priors)
+        if scan is not None:
+            factors.append(scan)
+        names = [n for f in factors for n in f.names]
+        return Reference({n: priors[n] for n in names}, tuple(factors), REFERENCE_SHARE)
+    except ValueError as err:  # a degenerate posterior: start from the prior alone
+        log.warning("no reference for %s (%s); its TMCMC starts from the prior", effect, err)
+        return None
+
+
+def scan_factor(effect: str, detection: Detection | None,
+                priors: Mapping[str, PriorSpec]) -> ScanFactor | None:
+    """The candidate's ``Probe.start_shape`` where the detection's scan of it places it:
+    log-normal components at the scanned values, one grid step wide (the median log
+    spacing), weighted by exp(statistic / 2) summed over each value's signatures (the score
+    test's likelihood ratio). None where the effect has no start shape or fewer than 3 values
+    were scanned."""
+    probe = PROBES.get(effect)
+    if detection is None or probe is None or probe.start_shape is None:
+        return None
+    name = probe.start_shape
+    idx = [i for i, sig in enumerate(detection.signatures)
+           if sig.effect == effect and name in sig.shape]
+    values = np.array([detection.signatures[i].shape[name] for i in idx], dtype=float)
+    z = np.asarray(detection.z, dtype=float)[idx]
+    stat = z**2 if probe.signed else np.maximum(z, 0.0) ** 2
+    grid = np.unique(values)
+    lower = float(priors[name].lower)
+    if len(grid) < 3 or (np.isfinite(lower) and grid.min() <= lower):
+        return None
+    half = np.array([np.logaddexp.reduce(0.5 * stat[values == v]) for v in grid])
+    step = float(np.median(np.diff(np.log(grid))))
+    return ScanFactor(name, tuple(grid.tolist()), (step,) * len(grid),
+                      tuple(np.exp(half - half.max()).tolist()), lower)
+
+
+def describe_start(ref: Reference) -> str:
+    """One line for the log: what a candidate's reference is made of."""
+    parts = []
+    for f in ref.describe()["factors"]:
+        if f["kind"] == "gaussian":
+            parts.append("the nested model's posterior (" + ", ".join(f["variables"]) + ")")
+        else:
+            parts.append(f"the scan of {f['variable']} (heaviest at "
+                         + ", ".join(f"{c:.3g}" for c in f["heaviest"]) + ")")
+    return " and ".join(parts)
+
+
 def fit_structure(problem: ChainProblem, structure: ModelStructure,
                   priors: Mapping[str, PriorSpec], settings: ConfirmSettings,
-                  seed_offset: int = 0) -> ModelFit:
-    """TMCMC of ``structure`` on the data, window, chain and tempering of ``problem``."""
+                  seed_offset: int = 0, reference: Reference | None = None) -> ModelFit:
+    """TMCMC of ``structure`` on the data, window, chain and tempering of ``problem``
+    (from ``reference`` instead of the prior where given)."""
     p = chain_problem(problem, problem.temper, problem.lowpass_hz, problem.filter_order,
                       structure=structure)
-    idata = identify(p, priors, settings.tmcmc(seed_offset))
+    idata = identify(p, priors, settings.tmcmc(seed_offset), reference)
     samples = posterior_theta(idata)
     ev = log_evidence(idata)
     used = priors_for(p, priors)
@@ -307,7 +391,7 @@ def fit_structure(problem: ChainProblem, structure: ModelStructure,
     log.info("%s: log evidence %s (TMCMC chains, pooled %.2f)%s", structure.name,
              ", ".join(f"{e:.2f}" for e in ev), pooled_log_evidence(ev),
              f"; bridge sampling {bridge.log_evidence:.2f} +- {bridge.se:.2f}" if bridge else "")
-    return ModelFit(structure, p, samples, ev, idata, used, bridge)
+    return ModelFit(structure, p, samples, ev, idata, used, bridge, reference)
 
 
 def bridge_evidence(problem: ChainProblem, priors: Mapping[str, PriorSpec],
@@ -331,18 +415,23 @@ def bridge_evidence(problem: ChainProblem, priors: Mapping[str, PriorSpec],
 
 
 def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSpec],
-            settings: ConfirmSettings, scale: MotionScale, seed_offset: int = 0
-            ) -> list[CandidateResult]:
-    """Sample each augmented structure; evidence against the baseline; acceptance."""
+            settings: ConfirmSettings, scale: MotionScale, seed_offset: int = 0,
+            detection: Detection | None = None) -> list[CandidateResult]:
+    """Sample each augmented structure; evidence against the baseline; acceptance.
+    ``detection``: the round's detection, whose scans place the start of candidates with a
+    ``Probe.start_shape`` (:func:`candidate_reference`)."""
     results = []
     for i, effect in enumerate(effects):
         structure = baseline.structure.with_term(effect)
         specs = {**candidate_priors(effect, scale, baseline.problem.known), **priors}
         run = replace(settings, particles=candidate_particles(effect, settings.particles))
-        log.info("confirming %s (%d of %d, %d particles per chain)", structure.name, i + 1,
-                 len(effects), run.particles)
+        ref = candidate_reference(effect, baseline, detection, priors_for(
+            baseline.problem, specs, baseline.names + term(effect).parameter_names))
+        log.info("confirming %s (%d of %d, %d particles per chain)%s", structure.name, i + 1,
+                 len(effects), run.particles, "" if ref is None else
+                 "; half the particles start from " + describe_start(ref))
         fit = fit_structure(baseline.problem, structure, specs, run,
-                            seed_offset=seed_offset + 101 * (i + 1))
+                            seed_offset=seed_offset + 101 * (i + 1), reference=ref)
         delta = fit.log_evidence - baseline.log_evidence
         se = float(np.hypot(fit.log_evidence_se, baseline.log_evidence_se))
         threshold = settings.base_threshold + settings.mc_sigmas * se

@@ -371,7 +371,7 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
                 baseline_fit = current_fit
         scale = motion_scale(state, (lead, hold), det.frame.f_high)
         rnd.confirmed = confirm(current_fit, [c.effect for c in chosen], specs, cs, scale,
-                                seed_offset=1000 * (r + 1))
+                                seed_offset=1000 * (r + 1), detection=det)
         best = rnd.accepted
         if best is None:
             if det.significant:

@@ -52,6 +52,9 @@ class Probe:
     the term's other parameters (others stay at the library's prior mean); reference:
     "baseline" (effect off = the baseline itself) or "zero" (the term kept with strength 0,
     when zero strength still changes the structure, as a backlash coupling does).
+    ``start_shape``: a shape parameter whose posterior is a peak too narrow for a few hundred
+    prior draws to hit (a resonance's frequency): the candidate's TMCMC starts part of its
+    particles where this scan's scores place it (``confirm.scan_factor``).
     """
 
     term: str
@@ -61,6 +64,7 @@ class Probe:
     shapes: ShapeGrid = field(default=lambda s: [{}])
     reference: str = "baseline"
     amount_is_shape: bool = False  # the strength itself is scanned (backlash clearance)
+    start_shape: str | None = None
 
 
 def _geom(lo: float, hi: float, n: int) -> list[float]:
@@ -87,7 +91,8 @@ PROBES: dict[str, Probe] = {p.term: p for p in (
                             for d in (1.0, 0.0)
                             for f in _geom(1.5, 0.95 * s.f_high,
                                            1 + int(np.log(0.95 * s.f_high / 1.5)
-                                                   / np.log(1.2)))]),
+                                                   / np.log(1.2)))],
+          start_shape="f_mode"),
     Probe("offset_force", "F_offset", lambda s: 0.5, signed=True),
     Probe("inertia_error", "dM", lambda s: 0.1, signed=True,
           shapes=lambda s: [{"m_share": share} for share in (0.0, 1.0)]),
