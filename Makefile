@@ -31,6 +31,7 @@ benchmark: $(STAMP)
 	$(BIN)/python benchmarks/bench_tmcmc.py
 	$(BIN)/python benchmarks/bench_resampling.py
 	$(BIN)/python benchmarks/bench_evidence.py
+	$(BIN)/python benchmarks/bench_reference.py
 
 detection: $(STAMP)
 	$(BIN)/snakemake --cores $(CORES) detection_all

@@ -90,6 +90,9 @@ class ConfirmSettings:
     bridge: re-estimate each model's evidence by bridge sampling from its final population
     (``harvester.evidence``; about one TMCMC stage's likelihood evaluations) and compare
     models on it, with its own standard error; TMCMC's chains are still reported.
+
+    reference: a candidate's TMCMC tempers from :func:`candidate_reference` (False: from the
+    prior, as the baseline's does).
     """
 
     particles: int = 300
@@ -102,6 +105,7 @@ class ConfirmSettings:
     mc_sigmas: float = 2.0
     indistinguishable_nats: float = 2.0
     bridge: bool = True
+    reference: bool = True
 
     def tmcmc(self, offset: int = 0) -> TMCMCSettings:
         return TMCMCSettings(particles=self.particles, chains=self.chains,
@@ -426,7 +430,8 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
         specs = {**candidate_priors(effect, scale, baseline.problem.known), **priors}
         run = replace(settings, particles=candidate_particles(effect, settings.particles))
         ref = candidate_reference(effect, baseline, detection, priors_for(
-            baseline.problem, specs, baseline.names + term(effect).parameter_names))
+            baseline.problem, specs, baseline.names + term(effect).parameter_names)) \
+            if settings.reference else None
         log.info("confirming %s (%d of %d, %d particles per chain)%s", structure.name, i + 1,
                  len(effects), run.particles, "" if ref is None else
                  "; half the particles start from " + describe_start(ref))

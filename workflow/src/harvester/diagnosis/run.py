@@ -59,7 +59,9 @@ class DiagnosisSettings:
     record is given; lowpass_hz: cut-off of the zero-phase low-pass the recording went
     through (None: found from its spectrum, ``spectral.filter_cutoff``); filter_order: its
     order; candidates: library terms considered (None: all); predictive_samples: posterior
-    samples simulated for the unseen-data comparison; figures: write figures.
+    samples simulated for the unseen-data comparison; figures: write figures;
+    reference_start: candidates' TMCMC tempers from the nested model's posterior and the
+    detection's scans (``confirm.candidate_reference``), else from their priors.
     """
 
     particles: int = 300
@@ -82,6 +84,7 @@ class DiagnosisSettings:
     candidates: tuple[str, ...] | None = None
     predictive_samples: int = 100
     figures: bool = True
+    reference_start: bool = True
 
     @classmethod
     def fast(cls, **overrides) -> "DiagnosisSettings":
@@ -109,7 +112,8 @@ class DiagnosisSettings:
     def confirmation(self) -> ConfirmSettings:
         return ConfirmSettings(particles=self.particles, chains=self.chains, seed=self.seed,
                                alpha=self.evidence_alpha,
-                               indistinguishable_nats=self.indistinguishable_nats)
+                               indistinguishable_nats=self.indistinguishable_nats,
+                               reference=self.reference_start)
 
 
 @dataclass
