@@ -107,10 +107,16 @@ def test_cli_end_to_end_writes_diagnosis_json(recording, tmp_path, capsys):
         for key in ("log_evidence", "delta_log_evidence", "log_evidence_tmcmc"):
             assert isinstance(c[key], float)
         assert c["log_evidence_method"] in ("bridge", "tmcmc")
-        # the candidate's TMCMC started half its particles at the linear model's posterior
+        # a secondary mode's TMCMC starts half its particles at the linear model's posterior
+        # and at the scan of its frequency; every other candidate's at its prior
         start = c["tempered_from"]
-        assert start["share"] == 0.5 and start["factors"][0]["kind"] == "gaussian"
-        assert set(start["factors"][0]["variables"]) == {"c_m", "sigma"}
+        if c["effect"] != "unmodelled_mode":
+            assert start is None
+        else:
+            assert start["share"] == 0.5 and start["factors"][0]["kind"] == "gaussian"
+            assert set(start["factors"][0]["variables"]) == {"c_m", "sigma"}
+            assert start["factors"][1]["variable"] == "f_mode"
+        assert c["restarted_from_prior"] in (False, True)
         for stats in c["parameters"].values():
             assert isinstance(stats["mean"], float) and isinstance(stats["sd"], float)
     loc = d["locations"]

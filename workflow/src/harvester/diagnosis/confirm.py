@@ -34,15 +34,16 @@ Particles. A candidate's TMCMC gets ``particles`` x (its added parameters / 2), 
 ``particles`` (``candidate_particles``): the secondary mode's four parameters hold a narrow
 peak in f_mode that few prior draws hit.
 
-Start. A candidate's TMCMC tempers from a reference distribution, not from the prior
-(``harvester.reference``, ``candidate_reference``): half its initial particles take the
-parameters it shares with the model it extends from that model's posterior (widened), and a
-``Probe.start_shape`` (the secondary mode's frequency) from the detection's scan of it; the
-other half come from the prior, which bounds the importance weights. The prior, the posterior
-and the evidence are unchanged; what changes is that the tempering no longer spends its first
-stages (and their resampling, which thins out every added parameter's values at random)
-re-finding the baseline's parameters, so a narrow peak of an added parameter survives to the
-stages where its likelihood gain counts.
+Start. The TMCMC of a candidate with a ``Probe.start_shape`` (the secondary mode's frequency)
+tempers from a reference distribution, not from the prior (``harvester.reference``,
+``candidate_reference``): half its initial particles take that shape from the detection's
+scan of it and the parameters the candidate shares with the model it extends from that
+model's posterior (widened); the other half come from the prior, which bounds the importance
+weights. The prior, the posterior and the evidence are unchanged; what changes is that the
+tempering no longer spends its first stages (and their resampling, which thins out the added
+parameters' values at random) re-finding the baseline's parameters, so the narrow peak in
+frequency survives to the stages where its likelihood gain counts. A population that
+collapsed all the same (:func:`collapsed`) is sampled again from the prior.
 """
 
 from __future__ import annotations
@@ -91,8 +92,8 @@ class ConfirmSettings:
     (``harvester.evidence``; about one TMCMC stage's likelihood evaluations) and compare
     models on it, with its own standard error; TMCMC's chains are still reported.
 
-    reference: a candidate's TMCMC tempers from :func:`candidate_reference` (False: from the
-    prior, as the baseline's does).
+    reference: a candidate with a start shape tempers from :func:`candidate_reference` (False:
+    from the prior, as the baseline and every other candidate do).
     """
 
     particles: int = 300
@@ -129,6 +130,7 @@ class ModelFit:
     priors: dict[str, PriorSpec] = field(default_factory=dict, repr=False)
     bridge: BridgeEstimate | None = None
     reference: Reference | None = None
+    restarted: bool = False  # the reference start collapsed; sampled again from the prior
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -176,7 +178,8 @@ class ModelFit:
                 "log_evidence_chains": [float(x) for x in self.log_evidence_chains],
                 "chains_missing_the_mode": self.missed_chains,
                 "log_evidence_bridge": self.bridge.to_dict() if self.bridge else None,
-                "tempered_from": self.reference.describe() if self.reference else None}
+                "tempered_from": self.reference.describe() if self.reference else None,
+                "restarted_from_prior": self.restarted}
 
     def summary(self) -> dict[str, dict[str, float]]:
         return {n: {"mean": float(self.samples[:, j].mean()),
@@ -317,27 +320,29 @@ REFERENCE_WIDEN = 1.5
 
 def candidate_reference(effect: str, nested: ModelFit, detection: Detection | None,
                         priors: Mapping[str, PriorSpec]) -> Reference | None:
-    """Where a candidate's TMCMC starts half its particles (``harvester.reference``): the
-    parameters it shares with the model it extends at that model's posterior (a Gaussian,
-    sds widened by REFERENCE_WIDEN), and its ``Probe.start_shape`` where the detection's scan
-    places it (:func:`scan_factor`); its other parameters from their priors. ``priors`` must be
-    the ones the candidate's model is built with. None where ``nested`` has no samples."""
-    if nested.samples is None or len(nested.samples) < 2 * len(nested.names):
+    """Where the TMCMC of a candidate with a ``Probe.start_shape`` starts half its particles
+    (``harvester.reference``): that shape where the detection's scan places it
+    (:func:`scan_factor`), the parameters it shares with the model it extends at that model's
+    posterior (a Gaussian, sds widened by REFERENCE_WIDEN), its other parameters from their
+    priors. ``priors`` must be the ones the candidate's model is built with.
+
+    None (start from the prior) for every other candidate: an added term that trades off
+    against the nested model's parameters (Coulomb friction against F_c, say) moves them
+    along a ridge the Gaussian does not hold, and its population started there collapsed in
+    3 of 5 runs (medium grid, commit e1e8381)."""
+    scan = scan_factor(effect, detection, priors)
+    if scan is None or nested.samples is None or len(nested.samples) < 2 * len(nested.names):
         return None
     lowers = tuple(float(priors[n].lower) for n in nested.names)
     inside = np.all(nested.samples >= np.asarray(lowers)[None, :], axis=1)
     try:
-        factors: list = [GaussianFactor.from_samples(tuple(nested.names),
-                                                     nested.samples[inside], lowers,
-                                                     REFERENCE_WIDEN)]
-        scan = scan_factor(effect, detection, priors)
-        if scan is not None:
-            factors.append(scan)
-        names = [n for f in factors for n in f.names]
-        return Reference({n: priors[n] for n in names}, tuple(factors), REFERENCE_SHARE)
-    except ValueError as err:  # a degenerate posterior: start from the prior alone
-        log.warning("no reference for %s (%s); its TMCMC starts from the prior", effect, err)
-        return None
+        gaussian = GaussianFactor.from_samples(tuple(nested.names), nested.samples[inside],
+                                               lowers, REFERENCE_WIDEN)
+    except ValueError as err:  # a degenerate posterior: the scan alone
+        log.warning("no Gaussian start for %s (%s)", effect, err)
+        return Reference({scan.name: priors[scan.name]}, (scan,), REFERENCE_SHARE)
+    names = (*nested.names, scan.name)
+    return Reference({n: priors[n] for n in names}, (gaussian, scan), REFERENCE_SHARE)
 
 
 def scan_factor(effect: str, detection: Detection | None,
@@ -364,6 +369,25 @@ def scan_factor(effect: str, detection: Detection | None,
     step = float(np.median(np.diff(np.log(grid))))
     return ScanFactor(name, tuple(grid.tolist()), (step,) * len(grid),
                       tuple(np.exp(half - half.max()).tolist()), lower)
+
+
+#: A final TMCMC stage accepting at least this share of its moves had collapsed onto copies
+#: of a few particles (its moves have no size); a healthy one accepts 0.2-0.5.
+COLLAPSED_ACCEPTANCE = 0.9
+
+
+def collapsed(fit: ModelFit) -> bool:
+    """Whether a chain's population collapsed onto copies of a few particles: its last stage
+    accepted nearly every move, which happens when the proposal covariance, taken from the
+    population, has shrunk to nothing (seen once in 16 candidates started from a reference
+    at 100 particles: the early stages, their moves too wide for the reference's cloud while
+    the prior's half was still alive, kept few distinct particles, and the last stage jumped
+    to beta = 1 from them; bridge estimate 140 nats low)."""
+    if fit.idata is None or "accept_rate" not in fit.idata.sample_stats:
+        return False
+    rates = fit.idata.sample_stats["accept_rate"].values
+    last = [row[np.isfinite(row)][-1] for row in np.atleast_2d(rates) if np.isfinite(row).any()]
+    return bool(any(r >= COLLAPSED_ACCEPTANCE for r in last))
 
 
 def describe_start(ref: Reference) -> str:
@@ -437,6 +461,12 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
                  "; half the particles start from " + describe_start(ref))
         fit = fit_structure(baseline.problem, structure, specs, run,
                             seed_offset=seed_offset + 101 * (i + 1), reference=ref)
+        if ref is not None and collapsed(fit):
+            log.warning("%s: the population started from the reference collapsed; sampled "
+                        "again from the prior", structure.name)
+            fit = fit_structure(baseline.problem, structure, specs, run,
+                                seed_offset=seed_offset + 101 * (i + 1))
+            fit.restarted = True
         delta = fit.log_evidence - baseline.log_evidence
         se = float(np.hypot(fit.log_evidence_se, baseline.log_evidence_se))
         threshold = settings.base_threshold + settings.mc_sigmas * se
