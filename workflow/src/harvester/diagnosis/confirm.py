@@ -328,8 +328,9 @@ def candidate_reference(effect: str, nested: ModelFit, detection: Detection | No
 
     None (start from the prior) for every other candidate: an added term that trades off
     against the nested model's parameters (Coulomb friction against F_c, say) moves them
-    along a ridge the Gaussian does not hold, and its population started there collapsed in
-    3 of 5 runs (medium grid, commit e1e8381)."""
+    along a ridge the Gaussian does not hold: started there, a chain collapsed in 3 of 10
+    Coulomb-friction runs (8 in the forced-candidate check, 2 in the medium grid; commit
+    e1e8381), against none of 10 Stribeck-friction runs."""
     scan = scan_factor(effect, detection, priors)
     if scan is None or nested.samples is None or len(nested.samples) < 2 * len(nested.names):
         return None
