@@ -64,8 +64,8 @@ from harvester.physics import term
 from harvester.posterior import pooled_log_evidence
 from harvester.priors import PriorSpec
 from harvester.pymc_models import default_prior, priors_for
-from harvester.structures import ModelStructure
 from harvester.reference import GaussianFactor, Reference, ScanFactor
+from harvester.structures import ModelStructure
 from harvester.tmcmc import log_evidence
 
 log = logging.getLogger("harvester.diagnosis")
