@@ -103,14 +103,13 @@ def identify(problem: Problem, priors: Mapping[str, PriorSpec],
     ``reference``: temper from it instead of the prior (``harvester.tmcmc.Reference``); its
     prior must be the one ``priors`` gives its variable."""
     model = build_model(problem, priors)
-    extra = {} if reference is None else {"reference": reference}
     log.info("TMCMC for %s: parameters %s, %d particles x %d chains, %d data points",
              problem.structure.name, ", ".join(problem.parameter_names), settings.particles,
              settings.chains, problem.n_data)
     idata = run_tmcmc(model, draws=settings.particles, chains=settings.chains, seed=settings.seed,
                       proposal_scale=settings.proposal_scale, target_cov=settings.target_cov,
                       mcmc_steps=settings.mcmc_steps, target_accept=settings.target_accept,
-                      **extra)
+                      reference=reference)
     idata.posterior.attrs["parameter_names"] = ",".join(problem.parameter_names)
     idata.posterior.attrs["model"] = problem.structure.name
     idata.posterior.attrs["terms"] = ",".join(problem.structure.terms)

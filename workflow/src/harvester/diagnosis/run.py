@@ -60,8 +60,9 @@ class DiagnosisSettings:
     through (None: found from its spectrum, ``spectral.filter_cutoff``); filter_order: its
     order; candidates: library terms considered (None: all); predictive_samples: posterior
     samples simulated for the unseen-data comparison; figures: write figures;
-    reference_start: candidates' TMCMC tempers from the nested model's posterior and the
-    detection's scans (``confirm.candidate_reference``), else from their priors.
+    reference_start: a candidate with a start shape (the secondary mode) tempers from the
+    detection's scan and the nested model's posterior (``confirm.candidate_reference``);
+    False: every candidate from its prior.
     """
 
     particles: int = 300
