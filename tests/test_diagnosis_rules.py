@@ -11,6 +11,7 @@ from harvester.diagnosis.detect import DetectionSettings, data_estimate, prior_c
 from harvester.diagnosis.rank import RankedCandidate, to_confirm
 from harvester.priors import PriorSpec
 from harvester.diagnosis.run import decide_verdict
+from harvester.diagnosis.signatures import candidate_terms
 
 
 def test_verdict_needs_evidence_or_a_strong_unexplained_detection():
@@ -81,3 +82,16 @@ def test_a_prior_conflict_gets_its_best_reliever_sampled():
     conflict = SimpleNamespace(alpha=0.05, conflict=True)
     assert [r.effect for r in to_confirm(ranked, conflict, top=3)] == \
         ["backlash", "quadratic_damping"]
+
+
+def test_a_refinement_of_friction_is_a_candidate_only_on_top_of_a_sliding_friction_law():
+    """A Stribeck excess or a direction-dependent part refines a sliding friction: on the
+    linear structure dry friction itself is the candidate; once it is in, they are."""
+    linear = candidate_terms(())
+    assert "coulomb_friction" in linear and "tanh_friction" in linear
+    assert "stribeck_friction" not in linear and "asymmetric_friction" not in linear
+    for law in ("tanh_friction", "coulomb_friction", "hysteresis"):
+        on_top = candidate_terms((law,))
+        assert {"stribeck_friction", "asymmetric_friction"} <= set(on_top), law
+        assert law not in on_top
+    assert candidate_terms((), ("stribeck_friction", "cubic_stiffness")) == ["cubic_stiffness"]

@@ -50,6 +50,9 @@ class Term:
     equation: str = ""
     description: str = ""
     kind: str = "screw"  # "screw", "mass", "inertia", "mode" or "coupling"
+    #: A refinement of one of these terms' laws, meaningless without one of them (a Stribeck
+    #: excess is over a sliding friction): a candidate only where one is in the structure.
+    refines: tuple[str, ...] = ()
 
     @property
     def parameter_names(self) -> tuple[str, ...]:
@@ -62,6 +65,10 @@ BASE_PARAMETERS: tuple[Parameter, ...] = (
     Parameter("k", "N/m", 250.0, 25.0, 0.0, "spring stiffness"),
     Parameter("c_m", "N s/m", 170.0, 50.0, 0.0, "translational viscous damping b_m, eq. (3)"),
 )
+
+#: Laws of sliding friction (Dahl's saturates to Coulomb's): what a Stribeck excess or a
+#: direction-dependent part refines.
+SLIDING_FRICTION: tuple[str, ...] = ("tanh_friction", "coulomb_friction", "hysteresis")
 
 _TERMS: tuple[Term, ...] = (
     Term("tanh_friction", 1, (
@@ -76,11 +83,13 @@ _TERMS: tuple[Term, ...] = (
         Parameter("F_stribeck", "N", 2.0, 2.0, 0.0, "excess of breakaway over sliding friction"),
         Parameter("v_stribeck", "m/s", 0.02, 0.02, 1e-4, "Stribeck velocity"),
     ), equation="f = F_stribeck exp(-(w / v_stribeck)^2) sgn(w)",
-        description="Stribeck effect: friction falls from breakaway as sliding speeds up"),
+        description="Stribeck effect: friction falls from breakaway as sliding speeds up",
+        refines=SLIDING_FRICTION),
     Term("asymmetric_friction", 4, (
         Parameter("F_asym", "N", 0.0, 2.0, None, "half the difference of down- and up-going friction"),
     ), equation="f = F_asym sgn(w)^2",
-        description="direction-dependent friction (gravity preload on a vertical screw)"),
+        description="direction-dependent friction (gravity preload on a vertical screw)",
+        refines=SLIDING_FRICTION),
     Term("quadratic_damping", 5, (
         Parameter("c_quad", "N s^2/m^2", 0.0, 200.0, 0.0, "quadratic damping coefficient"),
     ), equation="f = c_quad w |w|", description="velocity-squared (fluid-like) damping"),

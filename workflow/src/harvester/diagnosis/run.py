@@ -346,7 +346,6 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
         ev_source = "given posterior (eq. 10 untempered, no measurement chain)"
     det_problem = chain_problem(raw_det, temper, lowpass, order)
     fit_problem = chain_problem(raw_fit, temper, lowpass, order)
-    candidates = candidate_terms(base.terms, settings.candidates)
     ds = settings.detection()
 
     # ---- rounds of detect -> rank -> confirm
@@ -356,7 +355,7 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
     for r in range(settings.rounds + 1):
         state = baseline_state(chain_problem(det_problem, temper, lowpass, order,
                                              structure=current), current_samples)
-        cands = [c for c in candidates if c not in current.terms]
+        cands = candidate_terms(current.terms, settings.candidates)
         det = detect(state, (lead, hold), specs, cands, replace(ds, seed=ds.seed + r), time=t)
         ranked = rank(det, state, specs)
         rnd = Round(current.name, det, state, ranked)
