@@ -30,7 +30,8 @@ One stage of `TMCMC` (the order in which PyMC's ``sample_smc`` calls the methods
 
 Tempering from a reference. With ``reference`` (`Reference`) the walk starts from a
 distribution q that puts part of the population where other evidence (a residual's spectrum,
-a nested model's posterior) places some free variables, instead of the prior, and follows the geometric path
+a nested model's posterior) places some free variables, instead of the prior, and follows
+the geometric path
 
     f_j(theta) ∝ q(theta) ** (1 - beta_j) * (p(theta | M) * p(D | theta, M)) ** beta_j,
 
