@@ -1,5 +1,5 @@
 """Benchmark: the precision of the diagnosis's log evidence, TMCMC's alone and re-estimated by
-bridge sampling from each chain's final population (``harvester.evidence``).
+bridge sampling from each chain's final population (``harvester.inference.evidence``).
 
 One recording of the study's tanh device (``diagnosis.synthetic``, 0.04 m/s^2 sensors, 20 Hz
 filter) and one model with a concealed-size added term, each sampled by ``chains``
@@ -21,12 +21,12 @@ import numpy as np
 
 from harvester.diagnosis.baseline import chain_problem
 from harvester.diagnosis.confirm import ConfirmSettings, bridge_evidence
-from harvester.diagnosis.synthetic import TABLE1_KNOWN, TANH_TABLE5, measured_recording
-from harvester.identify import identify, make_problem, posterior_theta
-from harvester.priors import PriorSpec
-from harvester.pymc_models import priors_for
-from harvester.structures import structure
-from harvester.tmcmc import log_evidence
+from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
+from harvester.inference.identify import identify, make_problem, posterior_theta
+from harvester.inference.priors import PriorSpec
+from harvester.inference.priors import priors_for
+from harvester.model.structures import structure
+from harvester.inference.tmcmc import log_evidence
 
 FS = 256.0
 PRIORS = {"c_m": PriorSpec("c_m", 110.0, 50.0, "N s/m"), "F_c": PriorSpec("F_c", 10.0, 5.0, "N"),

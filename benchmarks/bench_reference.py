@@ -23,16 +23,16 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from harvester.detection import SIGMA_PRIOR
+from harvester.grid.scoring import SIGMA_PRIOR
 from harvester.diagnosis.baseline import baseline_state, chain_problem, fit_map
 from harvester.diagnosis.confirm import ConfirmSettings, confirm, fit_structure
 from harvester.diagnosis.detect import DetectionSettings, detect, estimate_temper
 from harvester.diagnosis.run import default_priors
 from harvester.diagnosis.signatures import motion_scale
-from harvester.identify import make_problem
-from harvester.priors import PriorSpec
-from harvester.scenarios import ScenarioSettings, make_scenario
-from harvester.structures import structure
+from harvester.inference.identify import make_problem
+from harvester.inference.priors import PriorSpec
+from harvester.synthetic.scenarios import ScenarioSettings, make_scenario
+from harvester.model.structures import structure
 
 EFFECT = "unmodelled_mode"
 ROOT = Path(__file__).resolve().parents[1]

@@ -15,10 +15,10 @@ import time
 import numpy as np
 
 from harvester.diagnosis.baseline import chain_problem, fit_map
-from harvester.diagnosis.synthetic import TABLE1_KNOWN, TANH_TABLE5, measured_recording
-from harvester.identify import make_problem
-from harvester.priors import PriorSpec
-from harvester.signals import resample_recording, resampling_ratio
+from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
+from harvester.inference.identify import make_problem
+from harvester.inference.priors import PriorSpec
+from harvester.data.signals import resample_recording, resampling_ratio
 
 FS, CUTOFF, ORDER = 500.0, 25.0, 8
 PRIORS = {"c_m": PriorSpec("c_m", 170.0, 50.0, "N s/m"), "F_c": PriorSpec("F_c", 8.4, 5.0, "N"),

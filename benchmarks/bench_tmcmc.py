@@ -16,13 +16,13 @@ import numpy as np
 import pymc as pm
 import yaml
 
-from harvester.daq import read_raw_record, to_accelerations
-from harvester.identify import make_problem
-from harvester.priors import prior_moments
-from harvester.pymc_models import build_model
-from harvester.signals import filter_recording
-from harvester.simulate import _simulate_batch, substeps
-from harvester.tmcmc import TMCMC, log_evidence, run_tmcmc
+from harvester.data.daq import read_raw_record, to_accelerations
+from harvester.inference.identify import make_problem
+from harvester.inference.priors import prior_moments
+from harvester.inference.pymc_model import build_model
+from harvester.data.signals import filter_recording
+from harvester.model.simulate import _simulate_batch, substeps
+from harvester.inference.tmcmc import TMCMC, log_evidence, run_tmcmc
 
 ROOT = Path(__file__).resolve().parents[1]
 

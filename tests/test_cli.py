@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from harvester.cli import main
-from harvester.daq import write_recording
+from harvester.data.daq import write_recording
 from harvester.diagnosis.confirm import candidate_priors
 from harvester.diagnosis.signatures import MotionScale
-from harvester.diagnosis.synthetic import TABLE1_KNOWN, TANH_TABLE5, measured_recording
-from harvester.initial import recording_priors
+from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
+from harvester.initial.recording import recording_priors
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning", "ignore::RuntimeWarning")
 

@@ -1,4 +1,4 @@
-"""File formats (harvester.daq): conversion, validation of bad input, checksums, committed data."""
+"""File formats (harvester.data.daq): conversion, validation of bad input, checksums, committed data."""
 
 from __future__ import annotations
 
@@ -10,9 +10,11 @@ import pandas as pd
 import pytest
 import yaml
 
-from harvester import daq, rig
-from harvester.dataset import make_raw_data
-from harvester.errors import DataError
+from harvester.data import daq
+
+from harvester.synthetic import rig
+from harvester.study.dataset import make_raw_data
+from harvester.data.errors import DataError
 
 ROOT = Path(__file__).parents[1]
 CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())

@@ -14,7 +14,7 @@ import yaml
 
 from conftest import ROOT, SNAKEMAKE
 
-from harvester import detection as det
+from harvester.grid import scoring as det
 
 
 def _truth(effect, ratio, seed, baseline="tanh"):

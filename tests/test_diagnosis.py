@@ -18,15 +18,15 @@ from harvester.diagnosis.confirm import backlash_contact_prior
 from harvester.diagnosis.detect import estimate_temper
 from harvester.diagnosis.rank import rank
 from harvester.diagnosis.spectral import filter_cutoff
-from harvester.diagnosis.synthetic import TABLE1_KNOWN, TANH_TABLE5, measured_recording
-from harvester.identify import make_problem
-from harvester.likelihood import DAQ_OVERSAMPLE
-from harvester.physics import Layout
-from harvester.priors import PriorSpec
-from harvester.pymc_models import default_prior
-from harvester.scenarios import ScenarioSettings, make_scenario
-from harvester.signals import lowpass
-from harvester.simulate import substeps
+from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
+from harvester.inference.identify import make_problem
+from harvester.inference.likelihood import DAQ_OVERSAMPLE
+from harvester.model.terms import Layout
+from harvester.inference.priors import PriorSpec
+from harvester.inference.priors import default_prior
+from harvester.synthetic.scenarios import ScenarioSettings, make_scenario
+from harvester.data.signals import lowpass
+from harvester.model.simulate import substeps
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning", "ignore::RuntimeWarning")
 
@@ -136,7 +136,7 @@ def test_no_false_alarm_on_effect_free_recordings(null_detections):
 
 @pytest.mark.parametrize("effect", ["end_stop", "unmodelled_mode", "asymmetric_friction"])
 def test_concealed_effect_below_noise_is_detected_and_named(effect):
-    # generated in another functional form than the library's (harvester.scenarios)
+    # generated in another functional form than the library's (harvester.synthetic.scenarios)
     sc = make_scenario(effect, 0.5, 11, ScenarioSettings(duration_s=16.0), masking=False)
     assert sc.truth["contribution_ratio"] == pytest.approx(0.5, rel=0.01)
     det, state = run_detection(sc.recording, seed=1)
@@ -200,8 +200,8 @@ def test_the_dissipative_force_is_the_power_the_base_puts_in():
     """c_eq sigma_v from the base's power input matches the simulated dissipation (viscous
     plus tanh friction) on a noisy low-passed recording, without knowing the split."""
     from harvester.diagnosis.signatures import dissipative_force
-    from harvester.diagnosis.synthetic import base_excitation
-    from harvester.simulate import simulate
+    from harvester.synthetic.measured import base_excitation
+    from harvester.model.simulate import simulate
 
     rng = np.random.default_rng(3)
     y = base_excitation(int(40 * FS), FS, rng, peak=4.0)

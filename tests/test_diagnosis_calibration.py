@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 
 from harvester.diagnosis import DiagnosisSettings, diagnose, quick_detect
-from harvester.diagnosis.synthetic import TABLE1_KNOWN, TANH_TABLE5, measured_recording
-from harvester.priors import PriorSpec
-from harvester.scenarios import ScenarioSettings, make_scenario
+from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
+from harvester.inference.priors import PriorSpec
+from harvester.synthetic.scenarios import ScenarioSettings, make_scenario
 
 pytestmark = [pytest.mark.slow,
               pytest.mark.filterwarnings("ignore::UserWarning", "ignore::RuntimeWarning")]
@@ -111,8 +111,8 @@ def test_evidence_acceptance_on_forced_candidates_at_most_5_percent():
     from harvester.diagnosis.detect import estimate_temper
     from harvester.diagnosis.run import default_priors
     from harvester.diagnosis.signatures import motion_scale
-    from harvester.identify import make_problem
-    from harvester.structures import structure
+    from harvester.inference.identify import make_problem
+    from harvester.model.structures import structure
 
     effects = ["coulomb_friction", "stribeck_friction"]
     accepted, deltas = 0, []

@@ -9,7 +9,7 @@ import pytest
 
 from harvester.diagnosis.detect import DetectionSettings, data_estimate, prior_conflicts
 from harvester.diagnosis.rank import RankedCandidate, to_confirm
-from harvester.priors import PriorSpec
+from harvester.inference.priors import PriorSpec
 from harvester.diagnosis.run import decide_verdict
 from harvester.diagnosis.signatures import candidate_terms
 

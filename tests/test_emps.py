@@ -1,4 +1,4 @@
-"""EMPS (harvester.emps) on slices of the real recordings: controller, closed loop, IDIM-LS."""
+"""EMPS (harvester.emps.closed_loop) on slices of the real recordings: controller, closed loop, IDIM-LS."""
 
 from __future__ import annotations
 
@@ -12,11 +12,11 @@ import xarray as xr
 import yaml
 
 from harvester import emps
-from harvester.errors import DataError
-from harvester.frf_priors import fit_linear_frf
-from harvester.identify import TMCMCSettings, identify
-from harvester.priors import PriorSpec
-from harvester.simulate import simulate
+from harvester.data.errors import DataError
+from harvester.initial.frf import fit_linear_frf
+from harvester.inference.identify import TMCMCSettings, identify
+from harvester.inference.priors import PriorSpec
+from harvester.model.simulate import simulate
 
 ROOT = Path(__file__).parents[1]
 CFG = yaml.safe_load((ROOT / "config/config.yaml").read_text())["emps"]

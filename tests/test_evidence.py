@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy import integrate, stats
 
-from harvester.evidence import (bridge_log_evidence, chains_bridge_log_evidence,
+from harvester.inference.evidence import (bridge_log_evidence, chains_bridge_log_evidence,
                                 effective_count)
 
 
@@ -120,10 +120,10 @@ def test_the_diagnosis_evidence_agrees_with_tmcmc_and_is_more_precise():
     smaller than that scatter."""
     from harvester.diagnosis.baseline import chain_problem
     from harvester.diagnosis.confirm import ConfirmSettings, fit_structure
-    from harvester.diagnosis.synthetic import TABLE1_KNOWN, TANH_TABLE5, measured_recording
-    from harvester.identify import make_problem
-    from harvester.priors import PriorSpec
-    from harvester.structures import structure
+    from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
+    from harvester.inference.identify import make_problem
+    from harvester.inference.priors import PriorSpec
+    from harvester.model.structures import structure
 
     rec, _ = measured_recording(("tanh_friction",), {**TABLE1_KNOWN, **TANH_TABLE5}, 7.0, 5)
     base = structure("tanh")

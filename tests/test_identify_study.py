@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 import yaml
 
-from harvester.daq import read_raw_record, to_accelerations
-from harvester.identify import TMCMCSettings, identify, make_problem, posterior_theta
-from harvester.priors import prior_moments
-from harvester.signals import filter_recording
+from harvester.data.daq import read_raw_record, to_accelerations
+from harvester.inference.identify import TMCMCSettings, identify, make_problem, posterior_theta
+from harvester.inference.priors import prior_moments
+from harvester.data.signals import filter_recording
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = yaml.safe_load((ROOT / "config/config.yaml").read_text())

@@ -17,15 +17,10 @@ import pandas as pd
 import pytest
 from scipy import signal
 
-from harvester.errors import DataError
-from harvester.initial import (
-    COULOMB_GAIN,
-    equivalent_linearisation,
-    fit_viscous_damping,
-    frf_relative_acceleration,
-    static_friction,
-)
-from harvester.signals import filter_recording
+from harvester.data.errors import DataError
+from harvester.initial.damping import COULOMB_GAIN, equivalent_linearisation, fit_viscous_damping, frf_relative_acceleration
+from harvester.initial.static_friction import static_friction
+from harvester.data.signals import filter_recording
 
 FS = 256.0
 M, MASS, K = 12.8, 8.0, 250.0      # kg, kg, N/m (Table 1)
@@ -190,7 +185,7 @@ def test_fit_recovers_c_m_with_coulomb_friction(coulomb_fit) -> None:
 
 
 def test_damping_fit_figure(coulomb_fit, tmp_path: Path) -> None:
-    from harvester.figures_data import fig_damping_fit
+    from harvester.plots.data import fig_damping_fit
 
     fig_damping_fit(coulomb_fit, tmp_path / "fit.png")
     assert (tmp_path / "fit.png").stat().st_size > 10_000

@@ -5,8 +5,8 @@ import pandas as pd
 import pytest
 from scipy.signal import butter, sosfilt
 
-from harvester.identify import make_problem
-from harvester.predictive import (NOMINAL_OUTSIDE, PredictiveBand, load_band, mlpd,
+from harvester.inference.identify import make_problem
+from harvester.inference.predictive import (NOMINAL_OUTSIDE, PredictiveBand, load_band, mlpd,
                                   posterior_predictive, save_band, validation_rows)
 
 FS = 256.0

@@ -1,5 +1,5 @@
-"""Priors of Tables 2 and 4 (harvester.priors) and the Table 1 they take their means from
-(harvester.tables)."""
+"""Priors of Tables 2 and 4 (harvester.inference.priors) and the Table 1 they take their means from
+(harvester.study.tables)."""
 
 from __future__ import annotations
 
@@ -11,10 +11,11 @@ import pandas as pd
 import pytest
 import yaml
 
-from harvester import paper
-from harvester.initial import DampingSummary, StaticFrictionEstimate
-from harvester.priors import PriorSpec, prior_moments, prior_table
-from harvester.tables import (
+from harvester.study import paper
+from harvester.initial.damping import DampingSummary
+from harvester.initial.static_friction import StaticFrictionEstimate
+from harvester.inference.priors import PriorSpec, prior_moments, prior_table
+from harvester.study.tables import (
     COLUMNS,
     SIMULATED_NOTE,
     compare_table,

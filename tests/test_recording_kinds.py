@@ -1,7 +1,7 @@
-"""Recording kinds (harvester.recording): input base_acc | force, output rel_acc | rel_disp.
+"""Recording kinds (harvester.data.recording): input base_acc | force, output rel_acc | rel_disp.
 
 Columns declare the kinds, units are checked, and fitting works for every combination on
-synthetic recordings with known truth (the model of ``harvester.simulate`` plus noise).
+synthetic recordings with known truth (the model of ``harvester.model.simulate`` plus noise).
 """
 
 from __future__ import annotations
@@ -13,14 +13,14 @@ import pandas as pd
 import pytest
 from scipy import signal
 
-from harvester import daq
-from harvester.errors import DataError
-from harvester.frf_priors import fit_linear_frf, initial_priors
-from harvester.identify import TMCMCSettings, identify, make_problem
-from harvester.physics import Layout
-from harvester.priors import PriorSpec
-from harvester.recording import G, RecordingKinds, check_plausible, recording_kinds
-from harvester.simulate import simulate
+from harvester.data import daq
+from harvester.data.errors import DataError
+from harvester.initial.frf import fit_linear_frf, initial_priors
+from harvester.inference.identify import TMCMCSettings, identify, make_problem
+from harvester.model.terms import Layout
+from harvester.inference.priors import PriorSpec
+from harvester.data.recording import G, RecordingKinds, check_plausible, recording_kinds
+from harvester.model.simulate import simulate
 
 FS = 200.0
 COMBINATIONS = [("base_acc", "rel_acc"), ("base_acc", "rel_disp"), ("force", "rel_acc"),

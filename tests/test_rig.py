@@ -1,4 +1,4 @@
-"""The virtual rig (harvester.rig): excitation, stick-slip mechanics, rocking mode, static test."""
+"""The virtual rig (harvester.synthetic.rig): excitation, stick-slip mechanics, rocking mode, static test."""
 
 from __future__ import annotations
 
@@ -12,7 +12,9 @@ import pytest
 import yaml
 from scipy import integrate, signal
 
-from harvester import daq, rig
+from harvester.data import daq
+
+from harvester.synthetic import rig
 
 CONFIG = yaml.safe_load((Path(__file__).parents[1] / "config" / "config.yaml").read_text())
 RIG = CONFIG["rig"]

@@ -14,7 +14,7 @@ from scipy.signal import welch
 
 from conftest import make_study_dir, run_snakemake, small_config
 
-from harvester.daq import read_raw_record, to_accelerations
+from harvester.data.daq import read_raw_record, to_accelerations
 
 
 @pytest.fixture(scope="module")
@@ -127,7 +127,7 @@ def test_validation_table_content(full_dir):
     lin = v[(v.model == "linear") & (v.bounds == "predictive")].set_index("data")
     assert (tanh.nrmse < lin.nrmse).all() and (tanh.mlpd > lin.mlpd).all()
     # coverage is computed from the samples: recompute one entry from the saved ensemble
-    from harvester.predictive import load_band, outside_fraction
+    from harvester.inference.predictive import load_band, outside_fraction
     band, measured, _, _ = load_band(full_dir / "results/predictive/tanh_validation.npz")
     row = v[(v.model == "tanh") & (v.data == "unseen") & (v.bounds == "parameter")].iloc[0]
     assert row.outside_3sigma == pytest.approx(
@@ -158,7 +158,7 @@ def test_bad_raw_input_stops_the_study_with_nothing_partial(tmp_path, study_dir,
         lines[5] = lines[5].replace("1", "2", 1)
     csv.write_text("\n".join(lines) + "\n")
     if corruption != "checksum":  # the checksum would catch it first: re-sign the bad file
-        from harvester.daq import write_checksums
+        from harvester.data.daq import write_checksums
         names = [line.split()[1] for line in (work / "data/raw/SHA256SUMS").read_text().splitlines()]
         write_checksums(work / "data/raw", names)
     proc = run_snakemake(work, "results/data/training_filtered.csv", check=False)

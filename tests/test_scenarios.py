@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from harvester import scenarios as sc
-from harvester.daq import read_recording
-from harvester.fileio import read_json
-from harvester.signals import lowpass
+from harvester.synthetic import scenarios as sc
+from harvester.data.daq import read_recording
+from harvester.data.fileio import read_json
+from harvester.data.signals import lowpass
 
 SETTINGS = sc.ScenarioSettings(duration_s=8.0, lead_in_s=1.0, seed=11)
 EFFECTS = list(sc.FAMILIES)

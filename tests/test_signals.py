@@ -1,4 +1,4 @@
-"""Zero-phase low-pass filter, PSD and H1 estimate (harvester.signals), Figures 4 and 5."""
+"""Zero-phase low-pass filter, PSD and H1 estimate (harvester.data.signals), Figures 4 and 5."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import pandas as pd
 import pytest
 import yaml
 
-from harvester.errors import DataError
-from harvester.signals import (CHANNELS, filter_recording, filter_response_db, frf_h1, lowpass,
+from harvester.data.errors import DataError
+from harvester.data.signals import (CHANNELS, filter_recording, filter_response_db, frf_h1, lowpass,
                                psd, uniform_step)
 
 CONFIG = yaml.safe_load((Path(__file__).parents[1] / "config" / "config.yaml").read_text())
@@ -99,7 +99,7 @@ def test_h1_of_a_gain_with_output_noise() -> None:
 
 
 def test_data_figures_are_written(two_tones: pd.DataFrame, tmp_path: Path) -> None:
-    from harvester.figures_data import fig04_psd, fig05_time_history
+    from harvester.plots.data import fig04_psd, fig05_time_history
 
     out = filter_recording(two_tones, CUTOFF, ORDER, channels=CHANNELS)
     fig04_psd(two_tones, out, FS, CUTOFF, tmp_path / "fig04.png")
@@ -115,7 +115,7 @@ def test_default_filters_the_output_only(two_tones: pd.DataFrame) -> None:
 
 
 def test_decimation_factor_keeps_the_rate_per_cutoff():
-    from harvester.signals import decimation_factor
+    from harvester.data.signals import decimation_factor
     assert decimation_factor(1024.0, 20.0) == 4
     assert decimation_factor(256.0, 20.0) == 1
     assert decimation_factor(1000.0, 18.2) == 4      # 250 Hz >= 12.8 x 18.2 = 233 Hz
@@ -123,7 +123,7 @@ def test_decimation_factor_keeps_the_rate_per_cutoff():
 
 
 def test_decimated_recording_keeps_the_band_and_its_time_base():
-    from harvester.signals import decimate_recording
+    from harvester.data.signals import decimate_recording
     fs, q = 1024.0, 4
     t = np.arange(int(20 * fs)) / fs
     rng = np.random.default_rng(3)
@@ -141,7 +141,7 @@ def test_decimated_recording_keeps_the_band_and_its_time_base():
 def test_a_rate_with_no_integer_factor_is_resampled_by_a_ratio():
     """500 Hz with a 25 Hz filter has no integer factor down to 12.8 x 25 = 320 Hz; it goes
     to 333 Hz (2/3), and the band's sines come through on the new time base."""
-    from harvester.signals import resample_recording, resampling_ratio
+    from harvester.data.signals import resample_recording, resampling_ratio
     assert resampling_ratio(500.0, 25.0) == (2, 3)
     assert resampling_ratio(1024.0, 20.0) == (1, 4)       # an integer factor is kept
     assert resampling_ratio(300.0, 20.0) == (1, 1)        # too little to gain
@@ -163,7 +163,7 @@ def test_a_rate_with_no_integer_factor_is_resampled_by_a_ratio():
 
 
 def test_sampling_rate_accepts_time_written_to_nine_decimals():
-    from harvester.signals import sampling_rate
+    from harvester.data.signals import sampling_rate
     t = np.round(np.arange(4096) / 1024.0, 9)      # 0.000976562, 0.001953125, ...
     assert sampling_rate(pd.DataFrame({"time": t})) == pytest.approx(1024.0, rel=1e-9)
 

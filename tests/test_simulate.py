@@ -5,8 +5,8 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.signal import butter, sosfilt, sosfiltfilt
 
-from harvester.physics import TERMS, Layout
-from harvester.simulate import simulate
+from harvester.model.terms import TERMS, Layout
+from harvester.model.simulate import simulate
 
 FS = 256.0
 DT = 1.0 / FS

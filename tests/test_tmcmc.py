@@ -1,4 +1,4 @@
-"""TMCMC kernel (harvester.tmcmc) and the batched black-box likelihood Op (harvester.batched).
+"""TMCMC kernel (harvester.inference.tmcmc) and the batched black-box likelihood Op (harvester.inference.batched).
 
 Problems with exact answers (linear-Gaussian evidence, conjugate Normal mean), agreement with
 PyMC's own SMC kernel, the Op's placement in ``datalogp`` and its one-call-per-batch contract,
@@ -18,10 +18,10 @@ import pytest
 from pytensor.graph.replace import vectorize_graph
 from scipy.stats import multivariate_normal
 
-from harvester.batched import BatchedLogLike, loglike_potential
-from harvester.priors import PriorSpec
-from harvester.reference import GaussianFactor, Reference, ScanFactor
-from harvester.tmcmc import (
+from harvester.inference.batched import BatchedLogLike, loglike_potential
+from harvester.inference.priors import PriorSpec
+from harvester.inference.reference import GaussianFactor, Reference, ScanFactor
+from harvester.inference.tmcmc import (
     TMCMC,
     TMCMCError,
     compile_population_logp,
@@ -278,7 +278,7 @@ def test_same_seed_same_samples_and_evidence():
 
 def test_run_tmcmc_statistics_and_progress_log(caplog):
     model = reference_model()
-    with caplog.at_level(logging.INFO, logger="harvester.tmcmc"):
+    with caplog.at_level(logging.INFO, logger="harvester.inference.tmcmc"):
         idata = run_tmcmc(model, draws=200, chains=2, seed=1)
     stats = idata.sample_stats
     assert stats["log_evidence"].dims == ("chain",)
@@ -292,7 +292,7 @@ def test_run_tmcmc_statistics_and_progress_log(caplog):
     assert np.all((stats["accept_rate"].values[np.isfinite(stats["accept_rate"].values)] > 0))
     assert stats.attrs["wall_time_s"] > 0 and stats.attrs["kernel"] == "TMCMC"
     assert np.all(stats["n_evals_total"].values > 0)
-    lines = [r.getMessage() for r in caplog.records if r.name == "harvester.tmcmc"]
+    lines = [r.getMessage() for r in caplog.records if r.name == "harvester.inference.tmcmc"]
     assert any("stage 1: beta=" in line and "log_evidence=" in line for line in lines)
     # A callable also works as the progress sink.
     seen: list[str] = []
@@ -410,8 +410,8 @@ def _peak_loglike(theta: np.ndarray) -> np.ndarray:
 
 def test_reference_finds_a_narrow_peak_the_prior_misses_and_keeps_the_evidence_exact():
     """As the diagnosis uses it: TMCMC from the reference, then the bridge estimate from its
-    final population (harvester.evidence)."""
-    from harvester.evidence import chains_bridge_log_evidence, log_target
+    final population (harvester.inference.evidence)."""
+    from harvester.inference.evidence import chains_bridge_log_evidence, log_target
 
     model = _peak_model()
     exact = _peak_exact_log_evidence()

@@ -17,7 +17,7 @@ def detection_grid():
 
 def detection_scenarios():
     """(effect, ratio, seed) of every scenario of the selected grid."""
-    from harvester.detection import scenario_grid
+    from harvester.grid.scoring import scenario_grid
 
     return scenario_grid(DETECTION)
 
@@ -27,7 +27,7 @@ def detection_files(kind, ext):
 
 
 def scenario_settings():
-    """Overrides of harvester.scenarios.ScenarioSettings beyond the rig and preprocessing."""
+    """Overrides of harvester.synthetic.scenarios.ScenarioSettings beyond the rig and preprocessing."""
     return {"duration_s": float(detection_grid()["duration_s"]),
             "lead_in_s": float(DETECTION["lead_in_s"]), "seed": int(DETECTION["seed"])}
 

@@ -1,5 +1,5 @@
 # EMPS (real recordings, Janot, Gautier and Brunot 2019): a study of its own, target emps_all.
-# The drive is simulated inside its digital position loop (harvester.emps); the viscous baseline
+# The drive is simulated inside its digital position loop (harvester.emps.closed_loop); the viscous baseline
 # and baseline + each candidate term are identified by TMCMC, the evidence names the missing
 # physics, the extended model's parameters are compared with the published ones and both models
 # are validated on the unseen DATA_EMPS_PULSES record.

@@ -2,8 +2,8 @@
 
 from pathlib import Path
 
-from harvester.daq import compare_checksums
-from harvester.fileio import atomic_path
+from harvester.data.daq import compare_checksums
+from harvester.data.fileio import atomic_path
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

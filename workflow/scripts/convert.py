@@ -1,6 +1,6 @@
 """Rule convert: raw DAQ voltages -> accelerations (m/s^2) and z'' = x'' - y''."""
 
-from harvester.daq import read_raw_record, to_accelerations, write_recording
+from harvester.data.daq import read_raw_record, to_accelerations, write_recording
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

@@ -1,9 +1,9 @@
 """Rule damping_fit: initial c_m by equivalent linearisation of Coulomb friction, FRF fit."""
 
-from harvester.daq import read_recording
-from harvester.figures_data import fig_damping_fit
-from harvester.fileio import read_json, write_json
-from harvester.initial import fit_viscous_damping
+from harvester.data.daq import read_recording
+from harvester.plots.data import fig_damping_fit
+from harvester.data.fileio import read_json, write_json
+from harvester.initial.damping import fit_viscous_damping
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

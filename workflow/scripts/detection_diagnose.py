@@ -2,9 +2,9 @@
 
 import numba
 
-from harvester.daq import read_recording
-from harvester.detection import run_diagnosis
-from harvester.fileio import read_json, write_json
+from harvester.data.daq import read_recording
+from harvester.grid.scoring import run_diagnosis
+from harvester.data.fileio import read_json, write_json
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

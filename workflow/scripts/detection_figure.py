@@ -3,7 +3,7 @@ each scenario's outcome against its information."""
 
 import pandas as pd
 
-from harvester.detection import detection_figure
+from harvester.grid.scoring import detection_figure
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

@@ -1,7 +1,7 @@
 """Rule detection_scenario: one concealed-effect scenario (recording CSV and truth JSON)."""
 
 from harvester.runlog import rule_log
-from harvester.scenarios import ScenarioSettings, make_scenario, write_scenario
+from harvester.synthetic.scenarios import ScenarioSettings, make_scenario, write_scenario
 
 with rule_log(snakemake) as log:  # noqa: F821
     sm = snakemake  # noqa: F821

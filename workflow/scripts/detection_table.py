@@ -1,8 +1,8 @@
 """Rule detection_table: detection table, confusion matrix and false-alarm rate."""
 
-from harvester.detection import (confusion_matrix, detection_table, false_alarms, goal_summary,
+from harvester.grid.scoring import (confusion_matrix, detection_table, false_alarms, goal_summary,
                                  results_table)
-from harvester.fileio import atomic_path, read_json
+from harvester.data.fileio import atomic_path, read_json
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

@@ -2,10 +2,10 @@
 
 import arviz as az
 
-from harvester.daq import read_recording
+from harvester.data.daq import read_recording
 from harvester.diagnosis.run import DiagnosisSettings, diagnose_study
-from harvester.fileio import read_json
-from harvester.priors import PriorSpec
+from harvester.data.fileio import read_json
+from harvester.inference.priors import PriorSpec
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

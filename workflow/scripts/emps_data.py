@@ -1,8 +1,8 @@
 """Rule emps_data: check the EMPS files, verify the controller law, IDIM-LS; data figure."""
 
 from harvester import emps
-from harvester.emps_figures import data_figure
-from harvester.fileio import write_json
+from harvester.emps.figures import data_figure
+from harvester.data.fileio import write_json
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

@@ -4,7 +4,7 @@ import arviz as az
 import pandas as pd
 
 from harvester import emps
-from harvester.fileio import atomic_path, read_json
+from harvester.data.fileio import atomic_path, read_json
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

@@ -5,10 +5,10 @@ from dataclasses import asdict
 import pandas as pd
 
 from harvester import emps
-from harvester.emps_figures import frf_figure
-from harvester.fileio import atomic_path, write_json
-from harvester.frf_priors import fit_linear_frf, frf_prior_specs
-from harvester.priors import prior_moments
+from harvester.emps.figures import frf_figure
+from harvester.data.fileio import atomic_path, write_json
+from harvester.initial.frf import fit_linear_frf, frf_prior_specs
+from harvester.inference.priors import prior_moments
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

@@ -3,8 +3,8 @@
 import arviz as az
 
 from harvester import emps
-from harvester.emps_figures import posterior_figure
-from harvester.fileio import atomic_path, read_json
+from harvester.emps.figures import posterior_figure
+from harvester.data.fileio import atomic_path, read_json
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

@@ -4,9 +4,9 @@ import arviz as az
 import numpy as np
 
 from harvester import emps
-from harvester.fileio import atomic_path, read_json, write_json
-from harvester.identify import posterior_theta
-from harvester.predictive import thin
+from harvester.data.fileio import atomic_path, read_json, write_json
+from harvester.inference.identify import posterior_theta
+from harvester.inference.predictive import thin
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

@@ -3,9 +3,9 @@
 import numpy as np
 
 from harvester import emps
-from harvester.fileio import atomic_path, read_json
-from harvester.identify import TMCMCSettings, identify
-from harvester.priors import PriorSpec
+from harvester.data.fileio import atomic_path, read_json
+from harvester.inference.identify import TMCMCSettings, identify
+from harvester.inference.priors import PriorSpec
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from harvester.emps_figures import tracking_figure
-from harvester.fileio import read_json
+from harvester.emps.figures import tracking_figure
+from harvester.data.fileio import read_json
 from harvester.runlog import rule_log
 
 with rule_log(snakemake):  # noqa: F821

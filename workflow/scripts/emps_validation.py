@@ -2,8 +2,8 @@
 
 import pandas as pd
 
-from harvester.emps import VALIDATION_COLUMNS
-from harvester.fileio import atomic_path, read_json
+from harvester.emps.results import VALIDATION_COLUMNS
+from harvester.data.fileio import atomic_path, read_json
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

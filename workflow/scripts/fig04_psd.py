@@ -1,9 +1,9 @@
 """Rule fig04_psd: Figure 4, PSD of z'' unfiltered and filtered."""
 
-from harvester.daq import read_recording
-from harvester.figures_data import fig04_psd
+from harvester.data.daq import read_recording
+from harvester.plots.data import fig04_psd
 from harvester.runlog import rule_log
-from harvester.signals import sampling_rate
+from harvester.data.signals import sampling_rate
 
 with rule_log(snakemake):  # noqa: F821
     sm = snakemake  # noqa: F821

@@ -1,7 +1,7 @@
 """Rule fig05_time_history: Figure 5, z'' unfiltered and filtered over the training window."""
 
-from harvester.daq import read_recording
-from harvester.figures_data import fig05_time_history
+from harvester.data.daq import read_recording
+from harvester.plots.data import fig05_time_history
 from harvester.runlog import rule_log
 
 with rule_log(snakemake):  # noqa: F821

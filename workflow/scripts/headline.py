@@ -2,9 +2,9 @@
 
 import pandas as pd
 
-from harvester.fileio import atomic_path
+from harvester.data.fileio import atomic_path
 from harvester.runlog import rule_log
-from harvester.summary import headline_html, headline_table
+from harvester.study.summary import headline_html, headline_table
 
 with rule_log(snakemake) as log:  # noqa: F821
     sm = snakemake  # noqa: F821

@@ -1,8 +1,8 @@
 """Rule lowpass: zero-phase low-pass filter of both channels (paper: 20 Hz)."""
 
-from harvester.daq import read_recording, write_recording
+from harvester.data.daq import read_recording, write_recording
 from harvester.runlog import rule_log
-from harvester.signals import filter_recording
+from harvester.data.signals import filter_recording
 
 with rule_log(snakemake) as log:  # noqa: F821
     sm = snakemake  # noqa: F821

@@ -9,7 +9,7 @@ import sys
 
 import yaml
 
-from harvester.dataset import make_raw_data
+from harvester.study.dataset import make_raw_data
 from harvester.runlog import rule_log, setup
 
 if __name__ == "__main__":

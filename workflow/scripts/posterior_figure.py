@@ -2,10 +2,10 @@
 
 import arviz as az
 
-from harvester import paper
-from harvester.figures_posterior import pair_plot
-from harvester.posterior import parameter_names, samples
-from harvester.posterior import posterior_truth
+from harvester.study import paper
+from harvester.plots.posterior import pair_plot
+from harvester.inference.posterior import parameter_names, samples
+from harvester.inference.posterior import posterior_truth
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

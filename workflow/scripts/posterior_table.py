@@ -2,10 +2,10 @@
 
 import arviz as az
 
-from harvester import paper
-from harvester.fileio import atomic_path
-from harvester.posterior import summary_table
-from harvester.posterior import posterior_truth
+from harvester.study import paper
+from harvester.data.fileio import atomic_path
+from harvester.inference.posterior import summary_table
+from harvester.inference.posterior import posterior_truth
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

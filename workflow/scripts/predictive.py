@@ -2,10 +2,10 @@
 
 import arviz as az
 
-from harvester.daq import read_recording
-from harvester.fileio import read_json
-from harvester.identify import make_problem, posterior_theta
-from harvester.predictive import posterior_predictive, save_band, thin
+from harvester.data.daq import read_recording
+from harvester.data.fileio import read_json
+from harvester.inference.identify import make_problem, posterior_theta
+from harvester.inference.predictive import posterior_predictive, save_band, thin
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

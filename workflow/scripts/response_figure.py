@@ -1,7 +1,7 @@
 """Rules fig07/fig09/fig10: model mean against measured response with 3-sigma bounds."""
 
-from harvester.figures_predictive import response_figure
-from harvester.predictive import load_band
+from harvester.plots.predictive import response_figure
+from harvester.inference.predictive import load_band
 from harvester.runlog import rule_log
 
 with rule_log(snakemake):  # noqa: F821

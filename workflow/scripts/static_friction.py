@@ -1,8 +1,8 @@
 """Rule static_friction: F_c from the static friction tests, eqs. (4)-(5)."""
 
-from harvester.daq import read_static_test
-from harvester.fileio import write_json
-from harvester.initial import static_friction
+from harvester.data.daq import read_static_test
+from harvester.data.fileio import write_json
+from harvester.initial.static_friction import static_friction
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

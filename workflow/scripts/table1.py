@@ -3,12 +3,12 @@
 from dataclasses import asdict
 from types import SimpleNamespace
 
-from harvester.fileio import atomic_path, read_json, write_json
-from harvester.initial import StaticFrictionEstimate
-from harvester.priors import prior_moments, prior_table
+from harvester.data.fileio import atomic_path, read_json, write_json
+from harvester.initial.static_friction import StaticFrictionEstimate
+from harvester.inference.priors import prior_moments, prior_table
 from harvester.runlog import rule_log
-from harvester.structures import structure
-from harvester.tables import render_table, table1, table1_notes, table1_values
+from harvester.model.structures import structure
+from harvester.study.tables import render_table, table1, table1_notes, table1_values
 
 with rule_log(snakemake) as log:  # noqa: F821
     sm = snakemake  # noqa: F821

@@ -1,9 +1,9 @@
 """Rule tmcmc: posterior and evidence of one model structure (netCDF)."""
 
-from harvester.fileio import atomic_path, read_json
-from harvester.identify import TMCMCSettings, identify, make_problem
-from harvester.priors import PriorSpec
-from harvester.daq import read_recording
+from harvester.data.fileio import atomic_path, read_json
+from harvester.inference.identify import TMCMCSettings, identify, make_problem
+from harvester.inference.priors import PriorSpec
+from harvester.data.daq import read_recording
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

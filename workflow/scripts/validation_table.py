@@ -1,7 +1,7 @@
 """Rule validation_table: NRMSE, coverage of 1/2/3-sigma bounds and MLPD per model and record."""
 
-from harvester.fileio import atomic_path
-from harvester.predictive import load_band, validation_rows, validation_table
+from harvester.data.fileio import atomic_path
+from harvester.inference.predictive import load_band, validation_rows, validation_table
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

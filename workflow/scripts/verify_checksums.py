@@ -1,7 +1,7 @@
 """Rule verify_checksums: stop the study if a raw file differs from its committed checksum."""
 
-from harvester.daq import verify_checksums
-from harvester.fileio import atomic_path
+from harvester.data.daq import verify_checksums
+from harvester.data.fileio import atomic_path
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

@@ -17,7 +17,7 @@ import logging
 import sys
 from pathlib import Path
 
-from harvester.errors import DataError
+from harvester.data.errors import DataError
 
 log = logging.getLogger("harvester.cli")
 
@@ -89,11 +89,11 @@ def _metadata(recording: Path) -> dict:
 
 
 def diagnose_command(args: argparse.Namespace) -> int:
-    from harvester.daq import read_recording
+    from harvester.data.daq import read_recording
     from harvester.diagnosis import DiagnosisSettings, check_recording, diagnose
-    from harvester.initial import recording_priors
-    from harvester.paper import TABLE1_KNOWN
-    from harvester.signals import filter_recording, sampling_rate
+    from harvester.initial.recording import recording_priors
+    from harvester.study.paper import TABLE1_KNOWN
+    from harvester.data.signals import filter_recording, sampling_rate
 
     logging.getLogger("pymc").setLevel(logging.ERROR)  # pymc sets INFO when imported
     df = read_recording(args.recording)

@@ -31,10 +31,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import optimize
 
-from harvester.likelihood import DAQ_OVERSAMPLE, Problem
-from harvester.priors import PriorSpec
-from harvester.pymc_models import priors_for
-from harvester.signals import lowpass
+from harvester.inference.likelihood import DAQ_OVERSAMPLE, Problem
+from harvester.inference.priors import PriorSpec
+from harvester.inference.priors import priors_for
+from harvester.data.signals import lowpass
 
 log = logging.getLogger("harvester.diagnosis")
 
@@ -49,7 +49,7 @@ ANALYSIS_FRACTION = 0.8
 
 @dataclass
 class ChainProblem(Problem):
-    """:class:`~harvester.likelihood.Problem` with the measurement chain and a tempered eq. (10).
+    """:class:`~harvester.inference.likelihood.Problem` with the measurement chain and a tempered eq. (10).
 
     The recordings went through a zero-phase low-pass (``lowpass_hz``, ``filter_order``;
     None: none); the simulated z'' did not, and its content above the cut-off (friction

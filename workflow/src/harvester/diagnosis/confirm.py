@@ -35,7 +35,7 @@ Particles. A candidate's TMCMC gets ``particles`` x (its added parameters / 2), 
 peak in f_mode that few prior draws hit.
 
 Start. The TMCMC of a candidate with a ``Probe.start_shape`` (the secondary mode's frequency)
-tempers from a reference distribution, not from the prior (``harvester.reference``,
+tempers from a reference distribution, not from the prior (``harvester.inference.reference``,
 ``candidate_reference``): half its initial particles take that shape from the detection's
 scan of it and the parameters the candidate shares with the model it extends from that
 model's posterior (widened); the other half come from the prior, which bounds the importance
@@ -58,15 +58,15 @@ import numpy as np
 from harvester.diagnosis.baseline import ChainProblem, chain_problem
 from harvester.diagnosis.detect import Detection
 from harvester.diagnosis.signatures import PROBES, MotionScale
-from harvester.evidence import BridgeEstimate, chains_bridge_log_evidence, log_target
-from harvester.identify import TMCMCSettings, identify, posterior_theta
-from harvester.physics import term
-from harvester.posterior import pooled_log_evidence
-from harvester.priors import PriorSpec
-from harvester.pymc_models import default_prior, priors_for
-from harvester.reference import GaussianFactor, Reference, ScanFactor
-from harvester.structures import ModelStructure
-from harvester.tmcmc import log_evidence
+from harvester.inference.evidence import BridgeEstimate, chains_bridge_log_evidence, log_target
+from harvester.inference.identify import TMCMCSettings, identify, posterior_theta
+from harvester.model.terms import term
+from harvester.inference.posterior import pooled_log_evidence
+from harvester.inference.priors import PriorSpec
+from harvester.inference.priors import default_prior, priors_for
+from harvester.inference.reference import GaussianFactor, Reference, ScanFactor
+from harvester.model.structures import ModelStructure
+from harvester.inference.tmcmc import log_evidence
 
 log = logging.getLogger("harvester.diagnosis")
 
@@ -89,7 +89,7 @@ class ConfirmSettings:
     3 moves per stage; measured on a 10 s recording with a concealed end stop).
 
     bridge: re-estimate each model's evidence by bridge sampling from its final population
-    (``harvester.evidence``; about one TMCMC stage's likelihood evaluations) and compare
+    (``harvester.inference.evidence``; about one TMCMC stage's likelihood evaluations) and compare
     models on it, with its own standard error; TMCMC's chains are still reported.
 
     reference: a candidate with a start shape tempers from :func:`candidate_reference` (False:
@@ -321,7 +321,7 @@ REFERENCE_WIDEN = 1.5
 def candidate_reference(effect: str, nested: ModelFit, detection: Detection | None,
                         priors: Mapping[str, PriorSpec]) -> Reference | None:
     """Where the TMCMC of a candidate with a ``Probe.start_shape`` starts half its particles
-    (``harvester.reference``): that shape where the detection's scan places it
+    (``harvester.inference.reference``): that shape where the detection's scan places it
     (:func:`scan_factor`), the parameters it shares with the model it extends at that model's
     posterior (a Gaussian, sds widened by REFERENCE_WIDEN), its other parameters from their
     priors. ``priors`` must be the ones the candidate's model is built with.
@@ -426,7 +426,7 @@ def fit_structure(problem: ChainProblem, structure: ModelStructure,
 def bridge_evidence(problem: ChainProblem, priors: Mapping[str, PriorSpec],
                     samples: np.ndarray, chain_evidence: np.ndarray, seed: int
                     ) -> BridgeEstimate | None:
-    """Bridge-sampling log evidence (``harvester.evidence.chains_bridge_log_evidence``) from
+    """Bridge-sampling log evidence (``harvester.inference.evidence.chains_bridge_log_evidence``) from
     the posterior samples of the chains whose own bridge estimate lies within
     MISSED_MODE_NATS of the best chain's (a chain stuck in a minor mode holds samples of the
     wrong weight; TMCMC's own chain estimates scatter by up to 6 nats without that, so they

@@ -44,8 +44,8 @@ from harvester.diagnosis.locate import (FrequencyBands, MeasuredStandstill, Stan
 from harvester.diagnosis.signatures import Signature, motion_scale, signatures
 from harvester.diagnosis.spectral import (Frame, Metric, Projector, level_envelope,
                                           noise_replicates, removed_input_psd)
-from harvester.priors import PriorSpec
-from harvester.pymc_models import default_prior
+from harvester.inference.priors import PriorSpec
+from harvester.inference.priors import default_prior
 
 log = logging.getLogger("harvester.diagnosis")
 

@@ -12,7 +12,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from harvester.fileio import atomic_path  # noqa: E402
+from harvester.data.fileio import atomic_path  # noqa: E402
 
 log = logging.getLogger("harvester.diagnosis")
 
@@ -172,7 +172,7 @@ def added_parameters(diag, path: Path) -> Path | None:
     fit = diag.improved_fit
     if fit is None:
         return None
-    from harvester.physics import term
+    from harvester.model.terms import term
     names = [p for t in diag.improved.terms if t not in diag.baseline.terms
              for p in term(t).parameter_names]
     if not names:

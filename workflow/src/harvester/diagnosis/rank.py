@@ -29,8 +29,8 @@ import numpy as np
 
 from harvester.diagnosis.baseline import BaselineState
 from harvester.diagnosis.detect import CandidateScore, Detection
-from harvester.priors import PriorSpec
-from harvester.pymc_models import default_prior
+from harvester.inference.priors import PriorSpec
+from harvester.inference.priors import default_prior
 
 #: Correlation of two projected signatures above which their effects are called similar.
 SIMILAR = 0.9

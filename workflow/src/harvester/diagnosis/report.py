@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from harvester.diagnosis.baseline import ChainProblem
-from harvester.predictive import nrmse, outside_fraction, thin
+from harvester.inference.predictive import nrmse, outside_fraction, thin
 
 
 @dataclass
@@ -117,7 +117,7 @@ def _detection(det) -> dict:
 
 
 def _equivalent(terms: tuple[str, ...]) -> str | None:
-    from harvester.structures import STRUCTURES
+    from harvester.model.structures import STRUCTURES
     for name, t in STRUCTURES.items():
         if set(t) == set(terms):
             return name
@@ -179,7 +179,7 @@ def _diagnosis_dict(d) -> dict:
            "likelihood": "eq. (10) on z'' through the measurement chain's low-pass, tempered "
                          "by lambda (effective share of independent samples)"}
     if d.improved_fit is not None:
-        from harvester.physics import term
+        from harvester.model.terms import term
         added = [p for t in d.improved.terms if t not in d.baseline.terms
                  for p in term(t).parameter_names]
         summ = d.improved_fit.summary()

@@ -20,7 +20,7 @@ import arviz as az
 import numpy as np
 import pandas as pd
 
-from harvester.daq import RECORDING_COLUMNS
+from harvester.data.daq import RECORDING_COLUMNS
 from harvester.diagnosis.baseline import BaselineState, baseline_state, chain_problem, fit_map
 from harvester.diagnosis.confirm import (CandidateResult, ConfirmSettings, ModelFit, confirm,
                                          fit_structure)
@@ -29,14 +29,14 @@ from harvester.diagnosis.rank import RankedCandidate, rank, to_confirm
 from harvester.diagnosis.report import UnseenFit, unseen_fit
 from harvester.diagnosis.signatures import candidate_terms, motion_scale
 from harvester.diagnosis.spectral import filter_cutoff
-from harvester.errors import DataError
-from harvester.identify import make_problem, posterior_theta
-from harvester.likelihood import Problem
-from harvester.posterior import parameter_names as idata_parameter_names
-from harvester.priors import PriorSpec
-from harvester.signals import resample_recording, resampling_ratio, uniform_step
-from harvester.structures import ModelStructure, structure as named_structure
-from harvester.tmcmc import log_evidence as idata_log_evidence
+from harvester.data.errors import DataError
+from harvester.inference.identify import make_problem, posterior_theta
+from harvester.inference.likelihood import Problem
+from harvester.inference.posterior import parameter_names as idata_parameter_names
+from harvester.inference.priors import PriorSpec
+from harvester.data.signals import resample_recording, resampling_ratio, uniform_step
+from harvester.model.structures import ModelStructure, structure as named_structure
+from harvester.inference.tmcmc import log_evidence as idata_log_evidence
 
 log = logging.getLogger("harvester.diagnosis")
 
@@ -234,7 +234,7 @@ def _posterior_samples(idata: az.InferenceData, names: tuple[str, ...]) -> np.nd
 def default_priors(structure: ModelStructure, sigma: float) -> dict[str, PriorSpec]:
     """Library priors of the structure's parameters, sigma ~ TN(s, s) with s the MAP's RMS
     residual (the noise level differs between rigs; every model shares this prior)."""
-    from harvester.pymc_models import default_prior
+    from harvester.inference.priors import default_prior
     out = {n: default_prior(n) for n in structure.free_parameters}
     out["sigma"] = PriorSpec("sigma", sigma, sigma, "m/s^2", 0.0)
     return out
@@ -486,7 +486,7 @@ def quick_detect(recording: pd.DataFrame, baseline: str | ModelStructure,
 
 def write(diag: Diagnosis, out_dir: str | Path) -> Path:
     """diagnosis.json and the figures in ``out_dir``; returns the JSON's path."""
-    from harvester.fileio import write_json
+    from harvester.data.fileio import write_json
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if diag.settings.figures:

@@ -22,8 +22,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from harvester.diagnosis.baseline import BaselineState
-from harvester.physics import TERMS, Layout, term
-from harvester.simulate import simulate
+from harvester.model.terms import TERMS, Layout, term
+from harvester.model.simulate import simulate
 
 log = logging.getLogger("harvester.diagnosis")
 

@@ -1,0 +1,1 @@
+"""Recordings: file formats, what a recording measures, signal processing, errors."""

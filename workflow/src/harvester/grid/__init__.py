@@ -1,0 +1,1 @@
+"""The concealed-effect grid: scenarios diagnosed, scored and tabulated."""

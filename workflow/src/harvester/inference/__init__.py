@@ -1,0 +1,1 @@
+"""Bayesian inference: the likelihood, priors, TMCMC, evidence, posterior summaries."""

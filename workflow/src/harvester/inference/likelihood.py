@@ -1,0 +1,180 @@
+"""The identification problem: data, a model structure and the Gaussian likelihood of eqs. (8)-(10).
+
+Each used sample of the measured output is modelled as N(y_hat_i(theta), sigma^2), independent
+(eq. 9), so log L = -N/2 log(2 pi sigma^2) - sum_i r_i^2 / (2 sigma^2), eq. (10), with sigma
+identified alongside the physical parameters. The model is simulated from the start of the
+record (from rest) and the likelihood uses every ``stride``-th sample in ``window``.
+
+Input and output kinds (``harvester.data.recording``): the model is driven by the base acceleration
+(``base_acc``, m/s^2, the paper's case) or by a force on the mass (``force``, N, base fixed,
+so m does not enter eq. 1), and predicts the relative acceleration (``rel_acc``, m/s^2, the
+paper's eq. 8) or the relative displacement (``rel_disp``, m). The model starts at rest at
+z = 0: a measured displacement is zero at the rest position the record starts from (the
+recording format says so, ``harvester.data.recording``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.signal import sosfiltfilt
+
+from harvester.data.recording import INPUT_KINDS, OUTPUT_KINDS
+from harvester.data.signals import butterworth_sos
+from harvester.model.simulate import Simulation, simulate
+from harvester.model.structures import ModelStructure
+
+
+#: The acquisition's view of the model: z'' simulated at this x the record's rate, low-passed
+#: and taken at every 4th sample (``simulate``'s ``oversample``), as a data acquisition with an
+#: anti-alias filter samples it. Point samples fold friction harmonics above the Nyquist
+#: frequency into the band: about 0.1 x the noise RMS on the study's tanh device.
+DAQ_OVERSAMPLE = 4
+
+
+@dataclass
+class Problem:
+    """What the sampler needs: theta = (free parameters..., sigma) -> log-likelihood.
+
+    ``input`` is the whole record of the input of kind ``input_kind`` ('base_acc' in m/s^2 or
+    'force' in N), ``output`` the measured output of kind ``output_kind`` ('rel_acc' in
+    m/s^2 or 'rel_disp' in m). ``base_acc`` and ``rel_acc`` are the paper-case names of the
+    same arrays (kept for the study's scripts).
+    """
+
+    structure: ModelStructure
+    input: np.ndarray  # whole record, unit of input_kind
+    output: np.ndarray  # measured, whole record, unit of output_kind
+    dt: float  # s
+    known: dict[str, float]  # values of the layout parameters that are not identified
+    window: tuple[int, int] | None = None  # samples [start, stop) used by the likelihood
+    output_filter: tuple[float, int] | None = None  # (cut-off Hz, order) applied to simulated z''
+    input_kind: str = "base_acc"
+    output_kind: str = "rel_acc"
+    stride: int = 1  # the likelihood uses every stride-th sample of the window
+    temper: float = 1.0  # power of the likelihood: eq. (10) x temper (1 / tau for correlated noise)
+    v_bound: float | None = None  # largest velocity (m/s) for the sub-step choice (simulate)
+    oversample: int = 1  # simulate at this x the rate and anti-alias z'' (simulate, a DAQ's view)
+    n_evaluations: int = field(default=0, init=False)
+
+    def __post_init__(self) -> None:
+        self.input = np.asarray(self.input, dtype=float)
+        self.output = np.asarray(self.output, dtype=float)
+        self._check_kinds()
+        if self.input.shape != self.output.shape:
+            raise ValueError(f"{self.input_kind} and {self.output_kind} differ in length")
+        layout = self.structure.layout
+        missing = [n for n in layout.parameter_names
+                   if n not in self.structure.free_parameters and n not in self.known]
+        if missing:
+            raise ValueError(f"no value for known parameters {missing} of {self.structure.name}")
+        start, stop = self.window or (0, len(self.output))
+        self.window = (int(start), int(stop))
+        if not 0 <= start < stop <= len(self.output):
+            raise ValueError(f"window {self.window} outside the record of {len(self.output)} "
+                             "samples")
+        self.stride = int(self.stride)
+        if self.stride < 1:
+            raise ValueError(f"stride must be a positive integer, got {self.stride}")
+        if not 0.0 < self.temper <= 1.0:
+            raise ValueError(f"temper must be in (0, 1], got {self.temper}")
+        self._free_idx = np.array([layout.index(n) for n in self.structure.free_parameters])
+        self._template = np.array([self.known.get(n, np.nan) for n in layout.parameter_names])
+
+    def _check_kinds(self) -> None:
+        if self.input_kind not in INPUT_KINDS:
+            raise ValueError(f"input_kind must be one of {list(INPUT_KINDS)}, "
+                             f"got {self.input_kind!r}")
+        if self.output_kind not in OUTPUT_KINDS:
+            raise ValueError(f"output_kind must be one of {list(OUTPUT_KINDS)}, "
+                             f"got {self.output_kind!r}")
+
+    # ---- paper-case names -------------------------------------------------------------------
+
+    @property
+    def base_acc(self) -> np.ndarray:
+        """The input record (the base acceleration in the paper's case)."""
+        return self.input
+
+    @property
+    def rel_acc(self) -> np.ndarray:
+        """The measured output record (the relative acceleration in the paper's case)."""
+        return self.output
+
+    # ---- data ---------------------------------------------------------------------------------
+
+    @property
+    def parameter_names(self) -> tuple[str, ...]:
+        """Names of theta's columns: the free physical parameters, then sigma."""
+        return self.structure.free_parameters + ("sigma",)
+
+    @property
+    def samples(self) -> slice:
+        """The samples of the record the likelihood uses."""
+        return slice(self.window[0], self.window[1], self.stride)
+
+    @property
+    def n_data(self) -> int:
+        return len(range(*self.samples.indices(len(self.output))))
+
+    @property
+    def observed(self) -> np.ndarray:
+        return self.output[self.samples]
+
+    # ---- model --------------------------------------------------------------------------------
+
+    def layout_params(self, theta: np.ndarray) -> np.ndarray:
+        """Full layout parameter matrix (particles, layout params) from theta (particles, P)."""
+        theta = np.atleast_2d(theta)
+        full = np.tile(self._template, (theta.shape[0], 1))
+        full[:, self._free_idx] = theta[:, : len(self._free_idx)]
+        return full
+
+    def simulate(self, theta: np.ndarray, input: np.ndarray | None = None, *,
+                 base_acc: np.ndarray | None = None) -> Simulation:
+        """Simulated response for each row of theta, to the training or another input.
+
+        ``base_acc`` is the paper-case name of ``input`` (either may be given).
+        """
+        u = self.input if input is None and base_acc is None else (
+            input if input is not None else base_acc)
+        return simulate(self.structure.layout, self.layout_params(theta), u, self.dt,
+                        force_input=self.input_kind == "force", v_bound=self.v_bound,
+                        oversample=self.oversample)
+
+    def output_of(self, sim: Simulation) -> np.ndarray:
+        """The simulated output of this problem's kind (particles, samples), NaN where failed."""
+        out = (sim.rel_acc if self.output_kind == "rel_acc" else sim.rel_disp).copy()
+        out[~sim.ok] = np.nan
+        if self.output_filter is not None and sim.ok.any():
+            cutoff, order = self.output_filter
+            sos = butterworth_sos(1.0 / self.dt, cutoff, order)
+            out[sim.ok] = sosfiltfilt(sos, out[sim.ok], axis=-1)
+        return out
+
+    def predict(self, theta: np.ndarray, input: np.ndarray | None = None) -> np.ndarray:
+        """Predicted output (particles, samples) for each row of theta (NaN where failed),
+        for the training input or another one."""
+        return self.output_of(self.simulate(theta, input))
+
+    def replace(self, **changes) -> "Problem":
+        """A copy with some fields changed (same class, kinds, stride; e.g. ``temper=0.1``)."""
+        return dataclasses.replace(self, **changes)
+
+    def loglike(self, theta: np.ndarray) -> np.ndarray:
+        """Log-likelihood, eq. (10) x ``temper``, per row of theta; -inf where simulation failed.
+
+        ``temper`` < 1 is the power likelihood L ** temper: with residuals correlated over
+        tau samples, temper = 1 / tau counts each independent piece of information once.
+        """
+        theta = np.atleast_2d(np.asarray(theta, dtype=float))
+        self.n_evaluations += theta.shape[0]
+        sigma = theta[:, -1]
+        r = self.predict(theta)[:, self.samples] - self.observed
+        n = self.n_data
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ll = -0.5 * n * np.log(2 * np.pi * sigma**2) - 0.5 * np.sum(r * r, axis=1) / sigma**2
+        ll[~(sigma > 0) | ~np.isfinite(ll)] = -np.inf
+        return self.temper * ll if self.temper != 1.0 else ll

@@ -1,0 +1,132 @@
+"""Prior distributions of Tables 2 (linear model) and 4 (tanh model), in one place.
+
+Each prior is a Gaussian truncated at zero (paper, 'Linear model' and 'Hyperbolic tangent').
+The config section ``priors`` gives, per parameter, either ``mean`` or ``from: table1`` (the
+mean is then our Table 1 estimate, as the paper took its means from its Table 1), plus ``sd``
+and ``unit``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+from harvester.model.terms import BASE_PARAMETERS, TERMS
+from harvester.study import paper
+
+if TYPE_CHECKING:
+    from harvester.inference.likelihood import Problem
+
+#: The paper's prior tables, by model structure.
+PAPER_PRIORS: dict[str, Mapping[str, tuple[float, float | None]]] = {
+    "linear": paper.TABLE2, "tanh": paper.TABLE4,
+}
+
+
+@dataclass(frozen=True)
+class PriorSpec:
+    """Gaussian prior N(mean, sd^2) truncated below at ``lower`` (0 in the paper), in ``unit``."""
+
+    name: str
+    mean: float
+    sd: float
+    unit: str
+    lower: float = 0.0
+
+    def distribution(self) -> Any:
+        """The truncated Gaussian as a frozen ``scipy.stats.truncnorm`` (upper bound +inf)."""
+        a = (self.lower - self.mean) / self.sd
+        return stats.truncnorm(a, np.inf, loc=self.mean, scale=self.sd)
+
+    def logpdf(self, x: Any) -> Any:
+        """Log density of the truncated prior (-inf below ``lower``)."""
+        return self.distribution().logpdf(x)
+
+
+def _prior_mean(name: str, entry: Mapping[str, Any], table1: Mapping[str, float]) -> float:
+    """Mean of one prior: ``entry['mean']`` or, with ``from: table1``, our Table 1 value."""
+    source = entry.get("from")
+    if source is not None and "mean" in entry:
+        raise ValueError(f"priors.{name}: give either 'mean' or 'from', not both")
+    if source is None:
+        if "mean" not in entry:
+            raise ValueError(f"priors.{name}: needs 'mean' or 'from: table1'")
+        return float(entry["mean"])
+    if source != "table1":
+        raise ValueError(f"priors.{name}: 'from' must be 'table1', got {source!r}")
+    if name not in table1:
+        raise ValueError(f"priors.{name}: 'from: table1' but Table 1 has no {name!r} "
+                         f"(has {sorted(table1)})")
+    return float(table1[name])
+
+
+def prior_spec(name: str, entry: Mapping[str, Any], table1: Mapping[str, float]) -> PriorSpec:
+    """One :class:`PriorSpec` from its config entry (keys mean|from, sd, unit, optional lower)."""
+    sd = float(entry.get("sd", np.nan))
+    if not sd > 0.0:
+        raise ValueError(f"priors.{name}: 'sd' must be a positive number, got {entry.get('sd')!r}")
+    return PriorSpec(name=name, mean=_prior_mean(name, entry, table1), sd=sd,
+                     unit=str(entry.get("unit", "")), lower=float(entry.get("lower", 0.0)))
+
+
+def prior_moments(config_priors: Mapping[str, Mapping[str, Any]],
+                  table1: Mapping[str, float]) -> dict[str, PriorSpec]:
+    """Prior of every parameter in config ``priors``; ``table1`` maps parameter -> our value.
+
+    Use :func:`harvester.study.tables.table1_values` to turn our Table 1 DataFrame into ``table1``.
+    """
+    return {name: prior_spec(name, entry, table1) for name, entry in config_priors.items()}
+
+
+def _paper_priors_for(model_params: Sequence[str]) -> Mapping[str, tuple[float, float | None]]:
+    """The paper table whose parameters are exactly ``model_params`` (Table 2 or Table 4)."""
+    for table in PAPER_PRIORS.values():
+        if set(table) == set(model_params):
+            return table
+    return paper.TABLE4
+
+
+def prior_table(model_params: Sequence[str], specs: Mapping[str, PriorSpec],
+                paper_priors: Mapping[str, tuple[float, float | None]] | None = None
+                ) -> pd.DataFrame:
+    """Our priors beside the paper's (Table 2 or 4) for the parameters of one model.
+
+    Columns: parameter, mean, sd, unit, paper_mean, paper_sd (NaN where the paper gives
+    none, e.g. sigma's sd in Table 2). ``paper_priors`` defaults to the paper table with the
+    same parameter set (Table 2 for {c_m, sigma}, otherwise Table 4).
+    """
+    missing = [p for p in model_params if p not in specs]
+    if missing:
+        raise ValueError(f"no prior for {missing}; config priors has {sorted(specs)}")
+    reference = _paper_priors_for(model_params) if paper_priors is None else paper_priors
+    rows = []
+    for name in model_params:
+        spec = specs[name]
+        paper_mean, paper_sd = reference.get(name, (np.nan, np.nan))
+        rows.append({"parameter": name, "mean": spec.mean, "sd": spec.sd, "unit": spec.unit,
+                     "paper_mean": float(paper_mean),
+                     "paper_sd": np.nan if paper_sd is None else float(paper_sd)})
+    return pd.DataFrame(rows, columns=["parameter", "mean", "sd", "unit", "paper_mean",
+                                       "paper_sd"])
+
+
+def default_prior(name: str) -> PriorSpec:
+    """The physics library's default prior of a parameter (used when config gives none)."""
+    for p in BASE_PARAMETERS + tuple(q for t in TERMS.values() for q in t.parameters):
+        if p.name == name:
+            lower = -np.inf if p.lower is None else p.lower
+            return PriorSpec(name=name, mean=p.prior_mean, sd=p.prior_sd, unit=p.unit, lower=lower)
+    raise KeyError(f"no prior for parameter {name!r}")
+
+
+def priors_for(problem: Problem, priors: Mapping[str, PriorSpec],
+               names: Sequence[str] | None = None) -> dict[str, PriorSpec]:
+    """Prior of each identified parameter (or of ``names``): from ``priors`` if given, else
+    the library default."""
+    names = problem.parameter_names if names is None else names
+    return {n: priors[n] if n in priors else default_prior(n) for n in names}

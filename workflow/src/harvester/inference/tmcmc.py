@@ -1,0 +1,693 @@
+"""Transitional MCMC (Ching & Chen, 2007) as a PyMC SMC kernel, with batched likelihood calls.
+
+Green et al. (2015) sample the posterior of each friction model with TMCMC and use its estimate
+of the evidence P(D|M) (their eq. 11) to compare model structures (eq. 7, 12). TMCMC walks from
+the prior to the posterior through tempered densities
+
+    f_j(theta) ∝ p(theta | M) * p(D | theta, M) ** beta_j,      0 = beta_0 < beta_1 < ... = 1.
+
+One stage of `TMCMC` (the order in which PyMC's ``sample_smc`` calls the methods):
+
+``update_beta_and_weights``
+    Choose beta_{j+1} by bisection so that the plausibility weights
+    w_k = L(theta_k) ** (beta_{j+1} - beta_j) have coefficient of variation ``target_cov``
+    (Ching & Chen: 100 %), capped at 1. The evidence gains the factor S_j = mean(w), so
+    log_evidence = sum_j log S_j, computed in log space with logsumexp.
+``resample``
+    Draw N particles with probabilities w_k / sum(w). ``resampling="multinomial"`` (default) is
+    Ching & Chen's choice: each particle is picked a multinomial number of times.
+    ``"systematic"`` (PyMC's default) has lower resampling variance; both are unbiased.
+``tune``
+    Proposal covariance = proposal_scale**2 * the weighted sample covariance of the stage's
+    particles (weights of this stage, computed before resampling; Ching & Chen's beta = 0.2).
+``mutate``
+    ``mcmc_steps`` random-walk Metropolis moves per particle, targeting f_{j+1}, in the model's
+    value-variable (unconstrained) space. Each move evaluates prior and likelihood of ALL N
+    proposals in one call of a compiled, vectorised function.
+``sample_stats``
+    Per-stage statistics (``stats_dtypes_shapes``) and a progress line on the logger
+    ``harvester.inference.tmcmc`` at INFO.
+
+Tempering from a reference. With ``reference`` (`Reference`) the walk starts from a
+distribution q that puts part of the population where other evidence (a residual's spectrum,
+a nested model's posterior) places some free variables, instead of the prior, and follows
+the geometric path
+
+    f_j(theta) ∝ q(theta) ** (1 - beta_j) * (p(theta | M) * p(D | theta, M)) ** beta_j,
+
+whose plausibility weights are w_k = (p L / q)(theta_k) ** (beta_{j+1} - beta_j). q is a
+normalised density, so the same product of mean weights estimates the evidence, and the last
+stage (beta = 1) targets the posterior as before. q = (1 - share) prior + share g is a
+defensive mixture (``harvester.inference.reference``), so that the weights p / q stay below
+1 / (1 - share). This is the reference-distribution path of stepping-stone sampling (Fan et
+al. 2011): a model that nests another can start where the other's posterior lies, and a
+posterior peak narrower than a few prior draws can hit (a resonance's frequency) can be found,
+without changing the prior, the posterior or the evidence.
+
+A NaN log-likelihood or log-prior is treated as -inf: such particles get zero weight and such
+proposals are rejected, so one failed simulation never stops a run. If every particle of a stage
+has zero likelihood the run stops with `TMCMCError`.
+
+Use `run_tmcmc` for an `arviz.InferenceData` with tidy statistics (per-chain `log_evidence`,
+tempering schedule, acceptance rates, likelihood evaluations, wall time).
+
+Reference: J. Ching and Y.-C. Chen (2007), "Transitional Markov chain Monte Carlo method for
+Bayesian model updating, model class selection, and model averaging", J. Eng. Mech. 133(7),
+816-832.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+import warnings
+from collections.abc import Callable, Sequence
+
+import arviz as az
+import numpy as np
+import pymc as pm
+import pytensor.tensor as pt
+import xarray as xr
+from pymc.blocking import DictToArrayBijection
+from pymc.logprob.utils import CheckParameterValue
+from pymc.model import Model, modelcontext
+from pymc.pytensorf import compile as pm_compile
+from pymc.pytensorf import floatX, join_nonshared_inputs, make_shared_replacements
+from pymc.smc.kernels import SMC_KERNEL, SMCSettings, SMCStats, systematic_resampling
+from pymc.vartypes import discrete_types
+from pytensor import shared
+from pytensor.graph.basic import Variable
+from pytensor.graph.replace import vectorize_graph
+from pytensor.graph.traversal import toposort
+from pytensor.tensor.random.type import RandomGeneratorType
+from scipy.special import logsumexp
+
+from harvester.inference.reference import Reference
+
+__all__ = [
+    "Reference",
+    "TMCMC",
+    "TMCMCError",
+    "compile_population_logp",
+    "log_evidence",
+    "next_beta",
+    "plausibility_log_weights",
+    "run_tmcmc",
+    "tidy_sample_stats",
+    "weighted_covariance",
+    "weights_cov",
+]
+
+logger = logging.getLogger("harvester.inference.tmcmc")
+
+RESAMPLING_SCHEMES = ("multinomial", "systematic")
+
+
+class TMCMCError(RuntimeError):
+    """TMCMC cannot continue (no particle has a finite likelihood, or a degenerate population)."""
+
+
+# --------------------------------------------------------------------------------------------
+# The algorithm's formulas, as plain functions of the population arrays
+# --------------------------------------------------------------------------------------------
+
+
+def plausibility_log_weights(likelihood_logp: np.ndarray, dbeta: float) -> np.ndarray:
+    """log w_k = (beta_new - beta_old) * log L_k, with log L = -inf giving log w = -inf."""
+    with np.errstate(invalid="ignore"):
+        return np.where(np.isneginf(likelihood_logp), -np.inf, dbeta * likelihood_logp)
+
+
+def weights_cov(log_weights: np.ndarray) -> float:
+    """Coefficient of variation std(w) / mean(w) of weights given in log space."""
+    top = np.max(log_weights)
+    if not np.isfinite(top):
+        return np.inf
+    w = np.exp(log_weights - top)
+    return float(np.std(w) / np.mean(w))
+
+
+def next_beta(
+    likelihood_logp: np.ndarray,
+    old_beta: float,
+    target_cov: float = 1.0,
+    rtol: float = 1e-8,
+    max_iter: int = 200,
+) -> tuple[float, np.ndarray]:
+    """Next tempering exponent and its unnormalised log plausibility weights (Ching & Chen).
+
+    Bisection on dbeta in (0, 1 - old_beta] for cov(w) = target_cov; cov(w) grows with dbeta.
+    If even beta = 1 gives cov(w) <= target_cov, beta = 1 (the last stage).
+    """
+    remaining = 1.0 - old_beta
+    log_w = plausibility_log_weights(likelihood_logp, remaining)
+    if weights_cov(log_w) <= target_cov:
+        return 1.0, log_w
+    low, high = 0.0, remaining
+    for _ in range(max_iter):
+        mid = 0.5 * (low + high)
+        if weights_cov(plausibility_log_weights(likelihood_logp, mid)) > target_cov:
+            high = mid
+        else:
+            low = mid
+        if high - low <= rtol * high:
+            break
+    # ``high`` > 0 always, so beta never stalls (a population with many -inf likelihoods can
+    # need a step of almost zero: that stage only removes them).
+    new_beta = min(old_beta + high, 1.0)
+    return new_beta, plausibility_log_weights(likelihood_logp, new_beta - old_beta)
+
+
+def weighted_covariance(particles: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """Sum_k w_k (theta_k - mean)(theta_k - mean)^T with normalised weights (Ching & Chen)."""
+    weights = weights / weights.sum()
+    mean = weights @ particles
+    centred = particles - mean
+    return np.atleast_2d((centred * weights[:, None]).T @ centred)
+
+
+def _cholesky_with_jitter(cov: np.ndarray) -> np.ndarray:
+    """Cholesky factor, adding a growing diagonal jitter if the covariance is degenerate."""
+    scale = max(float(np.mean(np.diag(cov))), 1e-12)
+    jitter = 0.0
+    for _ in range(12):
+        try:
+            return np.linalg.cholesky(cov + jitter * np.eye(len(cov)))
+        except np.linalg.LinAlgError:
+            jitter = scale * 1e-10 if jitter == 0.0 else jitter * 10.0
+    raise TMCMCError(f"the proposal covariance is not positive definite:\n{cov}")
+
+
+
+# --------------------------------------------------------------------------------------------
+# Compiling prior and likelihood of a PyMC model for a whole population
+# --------------------------------------------------------------------------------------------
+
+
+def _checks_per_particle(outputs: Sequence[Variable], check_bounds: bool) -> list[Variable]:
+    """Turn PyMC's parameter checks into ``switch(cond, logp, -inf)`` before vectorising.
+
+    PyMC does this rewrite when compiling, but ``vectorize_graph`` first turns a check into one
+    condition ``all()``-reduced over the batch, so a single particle with an invalid parameter
+    would set every particle's logp to -inf. Rewriting first keeps the check per particle.
+    """
+    memo: dict[Variable, Variable] = {}
+    for node in toposort(outputs):
+        inputs = [memo.get(inp, inp) for inp in node.inputs]
+        if isinstance(node.op, CheckParameterValue) and node.op.can_be_replaced_by_ninf:
+            logp, *conds = inputs
+            if check_bounds:
+                cond = pt.all([pt.all(c) for c in conds])
+                new = pt.switch(cond, logp, -np.inf).astype(node.outputs[0].dtype)
+            else:
+                new = logp
+            memo[node.outputs[0]] = new
+        elif any(new is not old for new, old in zip(inputs, node.inputs)):
+            new_node = node.clone_with_new_inputs(inputs, strict=False)
+            memo.update(zip(node.outputs, new_node.outputs))
+    return [memo.get(out, out) for out in outputs]
+
+
+def compile_population_logp(model: Model, compile_kwargs: dict | None = None):
+    """Compile ``f(particles[N, P]) -> (prior_logp[N], likelihood_logp[N])`` for ``model``.
+
+    Prior is ``model.varlogp`` (with the Jacobians of the value-variable transforms) and
+    likelihood is ``model.datalogp`` (observed variables and Potentials), as in PyMC's SMC.
+    Rows are the raveled value variables in ``model.value_vars`` order (PyMC's
+    ``join_nonshared_inputs``); the per-particle graph is vectorised with ``vectorize_graph``, so
+    each call evaluates every particle at once, and a `harvester.inference.batched.BatchedLogLike` in the
+    graph gets the whole matrix in one call.
+    """
+    value_vars = model.value_vars
+    discrete = [v.name for v in value_vars if v.dtype in discrete_types]
+    if discrete:
+        raise TypeError(f"TMCMC needs continuous free variables; {discrete} are discrete")
+    point = model.initial_point(random_seed=0)  # only the shapes are used
+    shared_replacements = make_shared_replacements(point, value_vars, model)
+    outputs, joined = join_nonshared_inputs(
+        point=point,
+        outputs=[model.varlogp, model.datalogp],
+        inputs=value_vars,
+        shared_inputs=shared_replacements,
+    )
+    outputs = _checks_per_particle(outputs, model.check_bounds)
+    particles = pt.matrix("particles", dtype=joined.dtype)
+    batched = vectorize_graph(outputs, replace={joined: particles})
+    kwargs = {"on_unused_input": "ignore", **(compile_kwargs or {})}
+    with model:
+        fn = pm_compile([particles], batched, **kwargs)
+    fn.trust_input = True
+    return fn
+
+
+def _reference_transforms(model: Model, names: Sequence[str], value_vars: Sequence[Variable]):
+    """Per covered variable: (column in the raveled particles, value -> model, model -> value).
+
+    The particles hold the value variables (PyMC's transformed space, e.g. log(x - lower) for
+    a truncated prior); the reference's densities are in the model's own units.
+    """
+    import pytensor
+
+    point = model.initial_point(random_seed=0)
+    offsets, start = {}, 0
+    for v in value_vars:
+        offsets[v] = start
+        start += int(np.size(point[v.name]))
+    out = []
+    for name in names:
+        try:
+            rv = model[name]
+        except KeyError:
+            raise ValueError(f"the reference's variable {name!r} is not in the model") from None
+        value = model.rvs_to_values[rv]
+        if value not in offsets:
+            raise ValueError(f"{name!r} is not a free variable of the model")
+        if np.size(point[value.name]) != 1:
+            raise ValueError(f"the reference's variable {name!r} must be a scalar")
+        transform = model.rvs_to_transforms.get(rv)
+        if transform is None:
+            out.append((offsets[value], lambda a: np.asarray(a, dtype=float),
+                        lambda a: np.asarray(a, dtype=float)))
+            continue
+        u = pt.dvector("u")
+        back = pytensor.function([u], transform.backward(u, *rv.owner.inputs))
+        fwd = pytensor.function([u], transform.forward(u, *rv.owner.inputs))
+        out.append((offsets[value],
+                    lambda a, f=back: np.asarray(f(np.asarray(a, dtype=float))),
+                    lambda a, f=fwd: np.asarray(f(np.asarray(a, dtype=float)))))
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# The kernel
+# --------------------------------------------------------------------------------------------
+
+
+class TMCMC(SMC_KERNEL):
+    """Transitional MCMC (Ching & Chen, 2007) SMC kernel with batched likelihood evaluations.
+
+    Use as ``pm.sample_smc(draws, kernel=TMCMC, proposal_scale=0.2, target_cov=1.0,
+    mcmc_steps=2, ...)`` or through `run_tmcmc`.
+
+    Parameters
+    ----------
+    proposal_scale : float, default 0.2
+        Ching & Chen's beta: the Metropolis proposal covariance is proposal_scale**2 times the
+        weighted sample covariance of the current stage.
+    target_cov : float, default 1.0
+        Coefficient of variation of the plausibility weights that sets each tempering step
+        (Ching & Chen: 100 %). Smaller values give more, gentler stages.
+    mcmc_steps : int, default 2
+        Metropolis moves per particle per stage.
+    target_accept : float or None, default None
+        None keeps ``proposal_scale`` fixed (Ching & Chen). A value (e.g. 0.25) adapts the scale
+        after every stage, scale <- scale * exp(2 (acceptance - target_accept)), as in Betz,
+        Papaioannou and Straub (2016): with a fixed 0.2 the particles cannot follow a posterior
+        that lies far in the prior's tail (acceptance stays near 0.9 and the population
+        collapses before it arrives). The scale used is recorded per stage.
+    resampling : {"multinomial", "systematic"}, default "multinomial"
+        Multinomial is Ching & Chen's scheme; systematic has lower variance.
+    reference : Reference or None, default None
+        Temper from this reference distribution instead of the prior (module docstring). None
+        gives Ching & Chen's path, unchanged to the last bit.
+    log : logging.Logger or callable(str) or None, default None
+        Where the per-stage progress line goes; None means the logger ``harvester.inference.tmcmc`` at
+        INFO. A callable must be picklable by cloudpickle if ``cores > 1``. The chain number in
+        the line is right when chains run sequentially (``cores=1``); with parallel chains each
+        process reports chain 0.
+    **kwargs
+        Passed to `pymc.smc.kernels.SMC_KERNEL` (``draws``, ``model``, ``random_seed``,
+        ``compile_kwargs``; ``threshold`` is not used by TMCMC).
+    """
+
+    stats_dtypes_shapes: dict[str, tuple[type, list]] = {
+        # PyMC's convention: NaN in every stage but the last, which holds the log evidence.
+        "log_marginal_likelihood": (float, []),
+        "beta": (float, []),
+        "accept_rate": (float, []),
+        # log S_j = log mean(w): this stage's factor of the evidence.
+        "log_mean_weight": (float, []),
+        # Achieved coefficient of variation and effective sample size of the weights.
+        "weights_cov": (float, []),
+        "ess": (float, []),
+        # Particle likelihood evaluations and wall time (s) in the stage; the first stage also
+        # counts evaluating the initial (prior) population.
+        "n_evals": (int, []),
+        "wall_time": (float, []),
+        "proposal_scale": (float, []),
+    }
+
+    def __init__(
+        self,
+        *args,
+        proposal_scale: float = 0.2,
+        target_cov: float = 1.0,
+        mcmc_steps: int = 2,
+        target_accept: float | None = None,
+        resampling: str = "multinomial",
+        reference: Reference | None = None,
+        log: logging.Logger | Callable[[str], None] | None = None,
+        **kwargs,
+    ):
+        if proposal_scale <= 0:
+            raise ValueError(f"proposal_scale must be positive, got {proposal_scale}")
+        if target_cov <= 0:
+            raise ValueError(f"target_cov must be positive, got {target_cov}")
+        if int(mcmc_steps) < 1:
+            raise ValueError(f"mcmc_steps must be at least 1, got {mcmc_steps}")
+        if resampling not in RESAMPLING_SCHEMES:
+            raise ValueError(f"resampling must be one of {RESAMPLING_SCHEMES}, got {resampling!r}")
+        super().__init__(*args, **kwargs)
+        if target_accept is not None and not 0.0 < target_accept < 1.0:
+            raise ValueError(f"target_accept must be in (0, 1) or None, got {target_accept}")
+        self.proposal_scale = float(proposal_scale)
+        self.initial_scale = float(proposal_scale)
+        self.target_accept = target_accept
+        self.target_cov = float(target_cov)
+        self.mcmc_steps = int(mcmc_steps)
+        self.resampling = resampling
+        self.log = log
+        model = modelcontext(kwargs.get("model"))
+        self.population_logp_func = compile_population_logp(model, kwargs.get("compile_kwargs"))
+        self.reference = reference
+        if reference is not None:
+            self._reference_columns = _reference_transforms(model, reference.names,
+                                                            self.variables)
+        self.chain = -1  # counts initialisations; the chain number when chains run sequentially
+        self._reset_stage_state()
+
+    # ---- setup -------------------------------------------------------------------------------
+
+    def _reset_stage_state(self) -> None:
+        self.log_mean_weight = np.nan
+        self.weights_cov = np.nan
+        self.ess = np.nan
+        self.acc_rate = np.nan
+        self.scale_used = np.nan
+        self.stage_particles: np.ndarray | None = None
+        self.proposal_chol: np.ndarray | None = None
+        self.n_evals = 0
+        self._stage_clock = time.perf_counter()
+
+    def set_rng(self, rng: np.random.Generator) -> None:
+        """As the base class, for the batched function too (a logp graph rarely holds RNGs)."""
+        super().set_rng(rng)
+        fn = self.population_logp_func
+        rngs = [v for v in fn.get_shared() if isinstance(v.type, RandomGeneratorType)]
+        if rngs:
+            swap = {old: shared(new, borrow=True) for old, new in zip(rngs, rng.spawn(len(rngs)))}
+            self.population_logp_func = fn.copy(swap=swap)
+
+    def _initialize_kernel(self) -> None:
+        """Initial population and its prior and likelihood, evaluated in ONE batched call.
+
+        The base class says this method should not be overridden, but it evaluates the
+        particles one at a time (N calls of the likelihood). The population is built exactly as
+        the base class does (``start`` or prior draws, raveled in ``value_vars`` order).
+        """
+        self.chain += 1
+        self._reset_stage_state()
+        self.proposal_scale = self.initial_scale
+        init = self.start if self.start else self.initialize_population()
+        population = [
+            DictToArrayBijection.map({v.name: init[v.name][i] for v in self.variables}).data
+            for i in range(self.draws)
+        ]
+        self.tempered_posterior = np.ascontiguousarray(floatX(np.array(population)))
+        note = ""
+        if self.reference is not None:
+            # a share of the particles takes the variable from g instead of the prior
+            from_g = self.rng.random(self.draws) < self.reference.share
+            drawn = self.reference.draw(self.rng, int(from_g.sum()))
+            for k, (col, _, to_value) in enumerate(self._reference_columns):
+                self.tempered_posterior[from_g, col] = to_value(drawn[:, k])
+            note = (f"; {int(from_g.sum())} start from the reference for "
+                    f"{', '.join(self.reference.names)}")
+        self.reference_log_ratio = self._log_ratio(self.tempered_posterior)
+        self.prior_logp, self.likelihood_logp = self.evaluate(self.tempered_posterior)
+        n_dead = int(np.sum(np.isneginf(self.likelihood_logp)))
+        self._say(
+            f"TMCMC chain {self.chain}: {self.draws} particles, {self.tempered_posterior.shape[1]}"
+            f" dimensions; {n_dead} initial particles have zero likelihood{note}"
+        )
+
+    def _log_ratio(self, particles: np.ndarray) -> np.ndarray:
+        """log q / prior of each particle (zeros without a reference)."""
+        if self.reference is None:
+            return np.zeros(len(particles))
+        x = np.column_stack([to_model(np.asarray(particles[:, col], dtype=float))
+                             for col, to_model, _ in self._reference_columns])
+        return np.asarray(self.reference.log_ratio(x), dtype=float)
+
+    def evaluate(self, particles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Log prior and log likelihood of every particle (one batched call); NaN -> -inf."""
+        n = len(particles)
+        prior_logp, likelihood_logp = self.population_logp_func(
+            np.ascontiguousarray(particles, dtype=self.tempered_posterior.dtype)
+        )
+        prior_logp = np.array(np.broadcast_to(prior_logp, (n,)), dtype=float)
+        likelihood_logp = np.array(np.broadcast_to(likelihood_logp, (n,)), dtype=float)
+        prior_logp[np.isnan(prior_logp)] = -np.inf
+        likelihood_logp[np.isnan(likelihood_logp)] = -np.inf
+        self.n_evals += n
+        return prior_logp, likelihood_logp
+
+    # ---- one stage ---------------------------------------------------------------------------
+
+    def update_beta_and_weights(self) -> None:
+        """Next beta for cov(w) = target_cov; weights; evidence factor S_j = mean(w)."""
+        self.iteration += 1
+        alive = np.isfinite(self.likelihood_logp)
+        if not alive.any():
+            raise TMCMCError(
+                f"TMCMC chain {self.chain}, stage {self.iteration} (beta={self.beta:.4g}): all "
+                f"{self.draws} particles have log-likelihood -inf or NaN, so the plausibility "
+                "weights are all zero. The likelihood is zero wherever the prior puts the "
+                "particles: check the data, the prior ranges and the likelihood function."
+            )
+        # log (p L / q) = log L - log (q / p): the log-likelihood itself without a reference
+        self.beta, log_w = next_beta(self.likelihood_logp - self.reference_log_ratio, self.beta,
+                                     self.target_cov)
+        log_sum = logsumexp(log_w)
+        self.log_mean_weight = float(log_sum - np.log(self.draws))
+        self.log_marginal_likelihood += self.log_mean_weight
+        self.weights = np.exp(log_w - log_sum)
+        self.weights /= self.weights.sum()
+        self.weights_cov = weights_cov(log_w)
+        self.ess = float(1.0 / np.sum(self.weights**2))
+
+    def resample(self) -> None:
+        """Draw N particles with probabilities w (multinomial or systematic)."""
+        self.stage_particles = self.tempered_posterior  # weighted population, used by tune()
+        if self.resampling == "multinomial":
+            self.resampling_indexes = self.rng.choice(self.draws, size=self.draws, p=self.weights)
+        else:
+            self.resampling_indexes = systematic_resampling(self.weights, self.rng)
+        self.tempered_posterior = self.tempered_posterior[self.resampling_indexes]
+        self.prior_logp = self.prior_logp[self.resampling_indexes]
+        self.likelihood_logp = self.likelihood_logp[self.resampling_indexes]
+        self.reference_log_ratio = self.reference_log_ratio[self.resampling_indexes]
+        self.tempered_posterior_logp = self._tempered(self.prior_logp, self.likelihood_logp,
+                                                      self.reference_log_ratio)
+
+    def _tempered(self, prior_logp: np.ndarray, likelihood_logp: np.ndarray,
+                  log_ratio: np.ndarray) -> np.ndarray:
+        """log f_beta = log p + beta log L + (1 - beta) log (q / p)."""
+        out = prior_logp + self.beta * likelihood_logp
+        return out if self.reference is None else out + (1.0 - self.beta) * log_ratio
+
+    def tune(self) -> None:
+        """Proposal covariance: proposal_scale**2 * weighted covariance of the stage."""
+        cov = self.proposal_scale**2 * weighted_covariance(self.stage_particles, self.weights)
+        if not np.all(np.isfinite(cov)):
+            raise TMCMCError(
+                f"TMCMC chain {self.chain}, stage {self.iteration}: the weighted sample "
+                "covariance is not finite (a particle has an infinite coordinate)"
+            )
+        self.proposal_chol = _cholesky_with_jitter(cov)
+
+    def mutate(self) -> None:
+        """``mcmc_steps`` Metropolis moves per particle, all particles evaluated at once."""
+        n, d = self.tempered_posterior.shape
+        accepted = 0
+        for _ in range(self.mcmc_steps):
+            step = self.rng.standard_normal((n, d)) @ self.proposal_chol.T
+            proposal = floatX(self.tempered_posterior + step)
+            prior_logp, likelihood_logp = self.evaluate(proposal)
+            ref_ratio = self._log_ratio(proposal)
+            with np.errstate(invalid="ignore"):
+                proposal_logp = self._tempered(prior_logp, likelihood_logp, ref_ratio)
+                proposal_logp[np.isnan(proposal_logp)] = -np.inf
+                log_ratio = proposal_logp - self.tempered_posterior_logp
+            log_u = np.log(self.rng.random(n))
+            accept = np.isfinite(proposal_logp) & (log_u < log_ratio)
+            self.tempered_posterior[accept] = proposal[accept]
+            self.prior_logp[accept] = prior_logp[accept]
+            self.likelihood_logp[accept] = likelihood_logp[accept]
+            self.reference_log_ratio[accept] = ref_ratio[accept]
+            self.tempered_posterior_logp[accept] = proposal_logp[accept]
+            accepted += int(accept.sum())
+        self.acc_rate = accepted / (n * self.mcmc_steps)
+        self.scale_used = self.proposal_scale
+        if self.target_accept is not None:
+            factor = np.exp(2.0 * (self.acc_rate - self.target_accept))
+            self.proposal_scale = float(np.clip(self.proposal_scale * factor, 1e-3, 5.0))
+
+    def sample_stats(self) -> SMCStats:
+        now = time.perf_counter()
+        stats = {
+            "log_marginal_likelihood": self.log_marginal_likelihood if self.beta == 1 else np.nan,
+            "beta": self.beta,
+            "accept_rate": self.acc_rate,
+            "log_mean_weight": self.log_mean_weight,
+            "weights_cov": self.weights_cov,
+            "ess": self.ess,
+            "n_evals": self.n_evals,
+            "wall_time": now - self._stage_clock,
+            "proposal_scale": self.scale_used,
+        }
+        self.n_evals = 0
+        self._stage_clock = now
+        self._say(
+            f"TMCMC chain {self.chain} stage {self.iteration}: beta={self.beta:.4g} "
+            f"(cov(w)={self.weights_cov:.2f}, ESS={self.ess:.0f}/{self.draws}), "
+            f"accept={self.acc_rate:.2f} (scale {self.scale_used:.3g}), log_evidence={self.log_marginal_likelihood:.3f}, "
+            f"{stats['n_evals']} evals in {stats['wall_time']:.2f} s"
+        )
+        return stats
+
+    def sample_settings(self) -> SMCSettings:
+        return {
+            "_n_draws": self.draws,
+            "_n_tune": self.mcmc_steps,
+            "kernel": "TMCMC",
+            "proposal_scale": self.initial_scale,
+            "target_cov": self.target_cov,
+            "mcmc_steps": self.mcmc_steps,
+            "target_accept": -1.0 if self.target_accept is None else self.target_accept,
+            "resampling": self.resampling,
+        }
+
+    def _say(self, message: str) -> None:
+        if self.log is None:
+            logger.info(message)
+        elif isinstance(self.log, logging.Logger):
+            self.log.info(message)
+        else:
+            self.log(message)
+
+
+# --------------------------------------------------------------------------------------------
+# Running it and reading the results
+# --------------------------------------------------------------------------------------------
+
+#: Per-stage statistics copied into run_tmcmc's sample_stats, with dims (chain, stage).
+STAGE_STATS = ("beta", "accept_rate", "log_mean_weight", "weights_cov", "ess", "n_evals",
+               "wall_time", "proposal_scale")
+
+
+def _per_chain_stage_lists(values, chains: int) -> list[np.ndarray]:
+    """PyMC's SMC sample_stats entry -> one 1-D float array per chain.
+
+    ``pm.sample_smc`` stores each statistic as an object array: (1, chains) of per-chain lists
+    when chains ran different numbers of stages, (1, chains, stages) of numbers when they ran
+    the same number, (1, stages) for one chain. All become ``chains`` rows.
+    """
+    rows = np.asarray(values, dtype=object).reshape(chains, -1)
+    return [
+        np.concatenate([np.atleast_1d(np.asarray(item, dtype=float)) for item in row])
+        for row in rows
+    ]
+
+
+def _ragged_to_matrix(rows: list[np.ndarray]) -> np.ndarray:
+    out = np.full((len(rows), max(len(r) for r in rows)), np.nan)
+    for i, row in enumerate(rows):
+        out[i, : len(row)] = row
+    return out
+
+
+def tidy_sample_stats(sample_stats: xr.Dataset, chains: int, wall_time: float) -> xr.Dataset:
+    """PyMC's SMC sample_stats (ragged object arrays) -> numeric arrays with a ``stage`` dim.
+
+    ``log_evidence`` (chain): final log evidence of each chain. Per stage (chain, stage), NaN
+    after a chain's last stage: ``beta`` (the tempering schedule), ``accept_rate``,
+    ``log_mean_weight``, ``weights_cov``, ``ess``, ``n_evals``, ``wall_time``,
+    ``log_marginal_likelihood`` (running sum of ``log_mean_weight``). Per chain: ``n_stages``,
+    ``n_evals_total``, ``wall_time_total``. Attributes keep PyMC's settings and add
+    ``wall_time_s`` (whole run).
+    """
+    raw = {name: _per_chain_stage_lists(sample_stats[name].values, chains)
+           for name in STAGE_STATS if name in sample_stats}
+    chain = np.arange(chains)
+    data = {
+        name: (("chain", "stage"), _ragged_to_matrix(rows)) for name, rows in raw.items()
+    }
+    running = [np.cumsum(rows) for rows in raw["log_mean_weight"]]
+    data["log_marginal_likelihood"] = (("chain", "stage"), _ragged_to_matrix(running))
+    data["log_evidence"] = (("chain",), np.array([r[-1] for r in running]))
+    data["n_stages"] = (("chain",), np.array([len(r) for r in running]))
+    data["n_evals_total"] = (("chain",), np.array([np.sum(r) for r in raw["n_evals"]], dtype=int))
+    data["wall_time_total"] = (("chain",), np.array([np.sum(r) for r in raw["wall_time"]]))
+    stages = data["beta"][1].shape[1]
+    attrs = {k: v for k, v in sample_stats.attrs.items()}
+    attrs["wall_time_s"] = float(wall_time)
+    return xr.Dataset(data, coords={"chain": chain, "stage": np.arange(1, stages + 1)},
+                      attrs=attrs)
+
+
+def run_tmcmc(
+    model: Model,
+    draws: int = 1000,
+    chains: int = 4,
+    seed: int | Sequence[int] | None = None,
+    *,
+    cores: int = 1,
+    progressbar: bool = False,
+    idata_kwargs: dict | None = None,
+    **kernel_kwargs,
+) -> az.InferenceData:
+    """Sample ``model`` with `TMCMC` and return InferenceData with tidy TMCMC statistics.
+
+    ``kernel_kwargs`` go to `TMCMC` (``proposal_scale``, ``target_cov``, ``mcmc_steps``,
+    ``resampling``, ``reference``, ``log``). ``idata.sample_stats`` is replaced by `tidy_sample_stats`:
+    ``log_evidence`` per chain, the tempering schedule ``beta`` (chain, stage), acceptance
+    rates, likelihood evaluations and wall times; numeric only, so it can be saved to netCDF.
+    """
+    start = time.perf_counter()
+    with warnings.catch_warnings():
+        # PyMC packs SMC stats as (1 chain, n chains) arrays; tidy_sample_stats redoes them.
+        warnings.filterwarnings("ignore", message="More chains", category=UserWarning)
+        idata = pm.sample_smc(
+            draws=draws,
+            kernel=TMCMC,
+            model=model,
+            chains=chains,
+            cores=cores,
+            random_seed=seed,
+            progressbar=progressbar,
+            compute_convergence_checks=False,
+            idata_kwargs=idata_kwargs,
+            **kernel_kwargs,
+        )
+    wall_time = time.perf_counter() - start
+    idata.sample_stats = tidy_sample_stats(idata.sample_stats, chains, wall_time)
+    return idata
+
+
+def log_evidence(idata: az.InferenceData) -> np.ndarray:
+    """Log evidence log P(D|M) of each chain.
+
+    Reads ``sample_stats.log_evidence`` (from `run_tmcmc`), or else the last finite entry of
+    PyMC's ``sample_stats.log_marginal_likelihood`` (any ``pm.sample_smc`` kernel).
+    """
+    stats = idata.sample_stats
+    if "log_evidence" in stats:
+        return np.asarray(stats["log_evidence"].values, dtype=float).reshape(-1)
+    raw = stats["log_marginal_likelihood"].values
+    chains = idata.posterior.sizes["chain"]  # PyMC's sample_stats has a dummy chain dim
+    out = []
+    for row in _per_chain_stage_lists(raw, chains):
+        finite = row[np.isfinite(row)]
+        out.append(finite[-1] if finite.size else np.nan)
+    return np.array(out)

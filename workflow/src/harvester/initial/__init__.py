@@ -1,0 +1,1 @@
+"""Initial modelling: priors from static friction tests and frequency responses."""

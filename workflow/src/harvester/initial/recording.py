@@ -1,0 +1,92 @@
+"""Priors for one recording of a device whose M, m, k are known (the command line's
+initial modelling).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping
+
+import numpy as np
+import pandas as pd
+
+from harvester.data.errors import DataError
+from harvester.initial.damping import DampingFit, fit_viscous_damping
+from harvester.inference.priors import PriorSpec, prior_spec
+
+log = logging.getLogger("harvester.initial")
+
+DAMPING_FIT_BAND_HZ = (0.3, 10.0)
+
+
+#: Prior sd of beta sigma_v (sigma_v the RMS velocity) for a recording's device: a tanh law
+#: this steep reverses within 1/50 of the RMS velocity (under 2 % of the samples) and
+#: differs from a sign law no more than the data can tell.
+BETA_SIGMA_V = 50.0
+
+
+def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
+                     given: Mapping[str, Mapping[str, float]] | None = None,
+                     source: str = "<recording>") -> dict[str, PriorSpec]:
+    """Priors for one recording of a device whose M, m, k are ``known``: c_m (and F_c) from the
+    recording's FRF (:func:`fit_viscous_damping`) as in the initial modelling, beta from its
+    RMS velocity, then the priors ``given`` (name -> entry as in config ``priors``: mean
+    or from: table1, sd, optional lower; e.g. a sidecar's). sigma's prior is left to the
+    diagnosis (scaled to the recording's residual, ``diagnosis.run.default_priors``) unless
+    given: Table 4's is the paper's rig's noise.
+
+    With a measured static friction (``given["F_c"]``, as the paper's static tests give) c_m's
+    mean is the FRF fit with that friction, sd Table 4's, as in the paper (a measured friction
+    that alone damps more than the recording shows drives c_m's posterior to zero, and that
+    conflict is evidence). Without one, the recording's damping cannot be split
+    between viscous damping and friction, and an assumed split must not make a prior conflict:
+    c_m is only known to lie between 0 and the purely viscous fit c_v, and F_c between 0 and
+    the friction that alone gives that damping, sqrt(pi/2) c_v sigma_v (equivalent
+    linearisation, c_eq = sqrt(2/pi) F_c / sigma_v): each prior is N(0, bound) truncated at 0.
+
+    beta sets the velocity 1/beta over which the friction force reverses; Table 4's 100 +- 100
+    s/m is beta sigma_v = 1.1 +- 1.1 on the paper's rig, but a friction law close to a sign law
+    (beta sigma_v of 75 on a test device, ``BETA_SIGMA_V``) would sit 25 sd in its tail. So
+    beta ~ N(0, BETA_SIGMA_V / sigma_v) truncated at 0, from smooth friction to a sign law.
+    """
+    from harvester.inference.priors import default_prior
+    from harvester.study.paper import TABLE1, TABLE4
+
+    unit = {n: default_prior(n).unit for n in ("c_m", "F_c", "beta")}
+    specs = {n: PriorSpec(n, m_, s_, unit[n]) for n, (m_, s_) in TABLE4.items() if n in unit}
+    stated = {}
+    for name, entry in (given or {}).items():
+        base = specs.get(name) or default_prior(name)
+        stated[name] = prior_spec(name, {"unit": base.unit, "lower": base.lower, **entry},
+                                  TABLE1)
+    lead_in = min(256, len(df) // 4)
+
+    def fit(friction: float) -> DampingFit:
+        return fit_viscous_damping(df, known["M"], known["m"], known["k"], friction,
+                                   DAMPING_FIT_BAND_HZ, lead_in=lead_in, source=source)
+
+    try:
+        if "F_c" in stated:
+            f_c = stated["F_c"].mean
+            measured = fit(f_c)
+            c_m, sigma_v = measured.c_m, measured.sigma_v
+            log.info("initial modelling: c_m = %.1f N s/m from the recording's FRF with the "
+                     "measured friction %.1f N", c_m, f_c)
+            specs["c_m"] = PriorSpec("c_m", c_m, TABLE4["c_m"][1], unit["c_m"])
+        else:
+            viscous = fit(0.0)
+            floor = 1e-6 * np.sqrt(known["k"] * known["M"])
+            c_v, sigma_v = max(viscous.c_m, floor), viscous.sigma_v
+            f_max = max(np.sqrt(np.pi / 2.0) * c_v * viscous.sigma_v, 1e-3)
+            log.info("initial modelling: the recording's FRF gives c_m = %.1f N s/m without "
+                     "friction (RMS velocity %.3g m/s); no measured friction, so c_m lies in "
+                     "0-%.1f N s/m and F_c in 0-%.2f N", c_v, viscous.sigma_v, c_v, f_max)
+            specs["c_m"] = PriorSpec("c_m", 0.0, c_v, unit["c_m"])
+            specs["F_c"] = PriorSpec("F_c", 0.0, float(f_max), unit["F_c"])
+        if sigma_v > 0.0:
+            specs["beta"] = PriorSpec("beta", 0.0, BETA_SIGMA_V / sigma_v, unit["beta"])
+            log.info("initial modelling: beta ~ N(0, %.0f s/m) truncated at 0 (beta sigma_v "
+                     "%g per sd)", BETA_SIGMA_V / sigma_v, BETA_SIGMA_V)
+    except (DataError, ValueError, np.linalg.LinAlgError) as err:
+        log.warning("FRF damping fit failed (%s); c_m, F_c and beta priors are Table 4's", err)
+    return {**specs, **stated}

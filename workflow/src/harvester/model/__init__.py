@@ -1,0 +1,1 @@
+"""The physics: named terms, model structures and the compiled simulator."""

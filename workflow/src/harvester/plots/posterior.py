@@ -1,0 +1,65 @@
+"""Figures 6 and 8: posterior samples of each model, pairwise, beside the paper's means."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from harvester.data.fileio import atomic_path  # noqa: E402
+
+SIMULATED_NOTE = "recordings: virtual rig (simulated)"
+UNITS = {"c_m": "N s/m", "F_c": "N", "beta": "s/m", "sigma": "m/s$^2$"}
+
+
+def label(name: str) -> str:
+    unit = UNITS.get(name)
+    return f"{name} ({unit})" if unit else name
+
+
+def pair_plot(samples: np.ndarray, names: list[str], path: str | Path, title: str,
+              paper: dict[str, float] | None = None, truth: dict[str, float] | None = None) -> None:
+    """Pairwise scatter of posterior samples (grey), paper's mean (black cross), rig truth (red)."""
+    n = len(names)
+    size = 2.4 * max(n, 2)
+    fig, axes = plt.subplots(n, n, figsize=(size, size), squeeze=False)
+    for i in range(n):
+        for j in range(n):
+            ax = axes[i, j]
+            if j > i:
+                ax.axis("off")
+                continue
+            if i == j:
+                ax.hist(samples[:, i], bins=30, color="0.6", edgecolor="0.3")
+                _mark_1d(ax, names[i], paper, "k", "paper")
+                _mark_1d(ax, names[i], truth, "tab:red", "rig truth")
+            else:
+                ax.plot(samples[:, j], samples[:, i], ".", color="0.45", ms=2, alpha=0.6)
+                _mark_2d(ax, names[j], names[i], paper, "k", "x")
+                _mark_2d(ax, names[j], names[i], truth, "tab:red", "+")
+            if i == n - 1:
+                ax.set_xlabel(label(names[j]))
+            if j == 0 and i > 0:
+                ax.set_ylabel(label(names[i]))
+    handles = [plt.Line2D([], [], color="k", marker="x", ls="--", label="paper (posterior mean)"),
+               plt.Line2D([], [], color="tab:red", marker="+", ls=":", label="virtual rig truth")]
+    fig.legend(handles=handles, loc="upper right", frameon=False)
+    fig.suptitle(f"{title}\n{SIMULATED_NOTE}", fontsize=10)
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=120, format="png")
+    plt.close(fig)
+
+
+def _mark_1d(ax, name, values, color, what) -> None:  # noqa: ANN001
+    if values and name in values and np.isfinite(values[name]):
+        ax.axvline(values[name], color=color, ls="--" if what == "paper" else ":", lw=1.2)
+
+
+def _mark_2d(ax, x, y, values, color, marker) -> None:  # noqa: ANN001
+    if values and x in values and y in values:
+        ax.plot(values[x], values[y], marker, color=color, ms=10, mew=2)

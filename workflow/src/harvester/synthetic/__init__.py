@@ -1,0 +1,1 @@
+"""Truth generators: the virtual rig and the concealed-effect scenarios, kept apart from the model on purpose."""
