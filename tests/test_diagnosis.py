@@ -21,7 +21,7 @@ from harvester.diagnosis.spectral import filter_cutoff
 from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
 from harvester.inference.identify import make_problem
 from harvester.inference.likelihood import DAQ_OVERSAMPLE
-from harvester.model.terms import Layout
+from harvester.model.structures import Layout
 from harvester.inference.priors import PriorSpec
 from harvester.inference.priors import default_prior
 from harvester.synthetic.scenarios import ScenarioSettings, make_scenario

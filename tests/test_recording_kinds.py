@@ -17,7 +17,7 @@ from harvester.data import daq
 from harvester.data.errors import DataError
 from harvester.initial.frf import fit_linear_frf, initial_priors
 from harvester.inference.identify import TMCMCSettings, identify, make_problem
-from harvester.model.terms import Layout
+from harvester.model.structures import Layout
 from harvester.inference.priors import PriorSpec
 from harvester.data.recording import G, RecordingKinds, check_plausible, recording_kinds
 from harvester.model.simulate import simulate

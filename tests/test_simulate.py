@@ -5,7 +5,8 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.signal import butter, sosfilt, sosfiltfilt
 
-from harvester.model.terms import TERMS, Layout
+from harvester.model.structures import Layout
+from harvester.model.terms import TERMS
 from harvester.model.simulate import simulate
 
 FS = 256.0

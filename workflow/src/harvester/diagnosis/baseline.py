@@ -32,6 +32,7 @@ import numpy as np
 from scipy import optimize
 
 from harvester.inference.likelihood import DAQ_OVERSAMPLE, Problem
+from harvester.model.simulate import Acquisition
 from harvester.inference.priors import PriorSpec
 from harvester.inference.priors import priors_for
 from harvester.data.signals import lowpass
@@ -67,7 +68,7 @@ class ChainProblem(Problem):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        self._observed_chain = self.chain(self.rel_acc)[self.window[0]:self.window[1]]
+        self._observed_chain = self.chain(self.rel_acc)[self.samples]
 
     @property
     def band_hz(self) -> float | None:
@@ -102,19 +103,13 @@ class ChainProblem(Problem):
     def residuals(self, theta: np.ndarray) -> np.ndarray:
         """Measured minus predicted z'' over the window, both through the chain (N, n_data)."""
         pred, _ = self.predicted(theta)
-        start, stop = self.window
-        return self.observed[None, :] - pred[:, start:stop]
+        return self.observed[None, :] - pred[:, self.samples]
 
-    def loglike(self, theta: np.ndarray) -> np.ndarray:
-        theta = np.atleast_2d(np.asarray(theta, dtype=float))
-        self.n_evaluations += theta.shape[0]
-        sigma = theta[:, -1]
-        r = self.residuals(theta)
-        n = self.n_data
-        with np.errstate(invalid="ignore", divide="ignore"):
-            ll = -0.5 * n * np.log(2 * np.pi * sigma**2) - 0.5 * np.sum(r * r, axis=1) / sigma**2
-        ll[~(sigma > 0) | ~np.isfinite(ll)] = -np.inf
-        return self.temper * ll
+    @property
+    def acquisition(self) -> Acquisition:
+        """The DAQ's oversampling and the likelihood's low-pass (``band_hz``)."""
+        band = self.band_hz
+        return Acquisition(self.oversample, None if band is None else (band, self.filter_order))
 
 
 #: Samples simulated beyond the window's end so that the zero-phase filter's end effect

@@ -22,7 +22,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from harvester.diagnosis.baseline import BaselineState
-from harvester.model.terms import TERMS, Layout, term
+from harvester.model.structures import Layout
+from harvester.model.terms import TERMS, term
 from harvester.model.simulate import simulate
 
 log = logging.getLogger("harvester.diagnosis")

@@ -42,23 +42,15 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
-import numba as nb
 import numpy as np
 
-from harvester.inference.likelihood import Problem
-from harvester.model.simulate import (
-    BLOW_UP,
-    MAX_SUBSTEPS,
-    RATE_H,
-    Simulation,
-    _rhs,
-    rk4_step,
-)
 from harvester.emps.data import EmpsRecord, ServoLoop, disturbance_voltage
-from harvester.model.structures import ModelStructure
-from harvester.model.terms import Layout, step_rates, term
+from harvester.inference.likelihood import Problem
+from harvester.model.simulate import Simulation, run_servo
+from harvester.model.structures import Layout, ModelStructure
+from harvester.model.terms import term
 
 log = logging.getLogger("harvester.emps")
 
@@ -73,93 +65,27 @@ BASELINE_TERMS: tuple[str, ...] = ("offset_force",)
 MIN_SUBSTEPS = 1
 
 
-@nb.njit(cache=True, error_model="numpy")
-def _closed_loop_one(qg, dist, dt, q0, gtau, kp, kv, p, codes, poff, soff, n_states, n_sub,
-                     out_q, out_v, out_a, out_f):
-    """One particle: digital controller at every sample, RK4 sub-steps with the force held."""
-    s = np.zeros(n_states)
-    s[0] = q0
-    k1 = np.zeros(n_states)
-    k2 = np.zeros(n_states)
-    k3 = np.zeros(n_states)
-    k4 = np.zeros(n_states)
-    tmp = np.zeros(n_states)
-    h = dt / n_sub
-    n = qg.shape[0]
-    q_1 = q0
-    q_2 = q0
-    for i in range(n):
-        q = s[0]
-        f = gtau * (kv * (kp * (qg[i] - q) - (q - q_2) / (2.0 * dt)) + dist[i])
-        out_q[i] = q
-        out_v[i] = s[1]
-        out_f[i] = f
-        out_a[i] = _rhs(s, f, p, codes, poff, soff, k1, True)
-        q_2 = q_1
-        q_1 = q
-        if i == n - 1:
-            break
-        for _ in range(n_sub):
-            rk4_step(s, f, 0.0, h, p, codes, poff, soff, k1, k2, k3, k4, tmp, True)
-        for e in range(n_states):
-            if not (abs(s[e]) < BLOW_UP):
-                return False
-    return True
-
-
-@nb.njit(cache=True, parallel=True, error_model="numpy")
-def _closed_loop_batch(qg, dist, dt, q0, gtau, kp, kv, params, codes, poff, soff, n_states,
-                       n_sub, qq, vv, aa, ff, ok):
-    for i in nb.prange(params.shape[0]):
-        ok[i] = _closed_loop_one(qg, dist, dt, q0, gtau, kp, kv, params[i], codes, poff, soff,
-                                 n_states, n_sub[i], qq[i], vv[i], aa[i], ff[i])
-
-
-@dataclass
-class ClosedLoopSimulation(Simulation):
-    """A closed-loop simulation: position (rel_disp, to ground), velocity, acceleration, force."""
-
-    force: np.ndarray = field(default=None)  # gtau vir_k applied over each sample (N)
+#: A closed-loop simulation: position (rel_disp, to ground), velocity, acceleration and the
+#: force gtau vir_k applied over each sample (``force``, N).
+ClosedLoopSimulation = Simulation
 
 
 def simulate_closed_loop(layout: Layout, params: np.ndarray, reference: np.ndarray,
                          disturbance: np.ndarray, loop: ServoLoop, dt: float, q0: float = 0.0,
                          n_substeps: int | np.ndarray | None = None,
-                         min_substeps: int = MIN_SUBSTEPS) -> ClosedLoopSimulation:
+                         min_substeps: int = MIN_SUBSTEPS) -> Simulation:
     """The model of ``layout`` (force input, base fixed) inside the digital position loop.
 
     ``reference`` qg (m) and ``disturbance`` d (V) are sampled every ``dt`` s; the model
     starts at rest at q0 (m). ``params`` is (particles, layout parameters) or one vector.
     Sub-steps per sample: as :func:`harvester.model.simulate.substeps` (rate x h <= RATE_H, for
-    stability) but at least ``min_substeps`` instead of 4, or ``n_substeps`` if given.
+    stability) but at least ``min_substeps`` instead of 4, or ``n_substeps`` if given. The
+    integrator is the structure's compiled kernel with the ``servo`` driver
+    (``harvester.model.codegen``).
     """
-    p = np.ascontiguousarray(np.atleast_2d(params), dtype=np.float64)
-    if p.shape[1] != len(layout.parameter_names):
-        raise ValueError(f"params has {p.shape[1]} columns, layout needs "
-                         f"{len(layout.parameter_names)}: {layout.parameter_names}")
-    qg = np.ascontiguousarray(reference, dtype=np.float64)
-    dist = np.ascontiguousarray(disturbance, dtype=np.float64)
-    if dist.shape != qg.shape:
-        raise ValueError("reference and disturbance differ in length")
-    n_part, n = p.shape[0], qg.shape[0]
-    valid = np.all(np.isfinite(p), axis=1) & (p[:, 0] > 0)
-    p = np.where(valid[:, None], p, 1.0)
-    if n_substeps is None:
-        steps = np.ceil(step_rates(layout, p) * dt / RATE_H)
-        steps = np.where(np.isfinite(steps), steps, MAX_SUBSTEPS)
-        n_sub = np.clip(steps, min_substeps, MAX_SUBSTEPS).astype(np.int64)
-    else:
-        n_sub = np.broadcast_to(np.asarray(n_substeps, dtype=np.int64), (n_part,)).copy()
-    qq, vv, aa, ff = (np.empty((n_part, n)) for _ in range(4))
-    ok = np.zeros(n_part, dtype=np.bool_)
-    _closed_loop_batch(qg, dist, float(dt), float(q0), loop.gtau, loop.kp, loop.kv, p,
-                       layout.codes, layout.param_offsets, layout.state_offsets, layout.n_states,
-                       n_sub, qq, vv, aa, ff, ok)
-    ok &= valid & np.all(np.isfinite(qq), axis=1)
-    for a in (qq, vv, aa, ff):
-        a[~ok] = np.nan
-    return ClosedLoopSimulation(rel_acc=aa, rel_disp=qq, rel_vel=vv, ok=ok, substeps=n_sub,
-                                force=ff)
+    _, sim = run_servo(layout, params, reference, disturbance, loop, dt, q0, n_substeps,
+                       min_substeps)
+    return sim
 
 
 @dataclass
@@ -186,8 +112,16 @@ class ClosedLoopProblem(Problem):
             self.disturbance = np.zeros_like(self.input)
         self.disturbance = np.asarray(self.disturbance, dtype=float)
 
+    def residual_sums(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(sum of squared position residuals, ok) per row of theta, without trajectories."""
+        sse, sim = run_servo(self.structure.layout, self.layout_params(theta), self.input,
+                             self.disturbance, self.loop, self.dt, float(self.output[0]),
+                             min_substeps=self.min_substeps, observed=self.observed,
+                             window=self.window, stride=self.stride, outputs=False)
+        return sse, sim.ok
+
     def simulate(self, theta: np.ndarray, input: np.ndarray | None = None, *,
-                 base_acc: np.ndarray | None = None) -> ClosedLoopSimulation:
+                 base_acc: np.ndarray | None = None) -> Simulation:
         if input is not None or base_acc is not None:
             raise ValueError("simulate another record with problem.for_record(record)")
         return simulate_closed_loop(self.structure.layout, self.layout_params(theta),

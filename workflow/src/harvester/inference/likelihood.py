@@ -23,7 +23,7 @@ from scipy.signal import sosfiltfilt
 
 from harvester.data.recording import INPUT_KINDS, OUTPUT_KINDS
 from harvester.data.signals import butterworth_sos
-from harvester.model.simulate import Simulation, simulate
+from harvester.model.simulate import Acquisition, Simulation, residual_sums, simulate
 from harvester.model.structures import ModelStructure
 
 
@@ -163,6 +163,19 @@ class Problem:
         """A copy with some fields changed (same class, kinds, stride; e.g. ``temper=0.1``)."""
         return dataclasses.replace(self, **changes)
 
+    @property
+    def acquisition(self) -> Acquisition:
+        """How the simulated output is sampled and filtered before it meets ``observed``."""
+        return Acquisition(self.oversample, self.output_filter)
+
+    def residual_sums(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(sum of squared residuals over the likelihood's samples, ok) per row of theta,
+        computed block by block by the compiled simulator (no trajectories are kept)."""
+        return residual_sums(self.structure.layout, self.layout_params(theta), self.input,
+                             self.dt, self.observed, self.window, self.stride, self.output_kind,
+                             self.acquisition, force_input=self.input_kind == "force",
+                             v_bound=self.v_bound)
+
     def loglike(self, theta: np.ndarray) -> np.ndarray:
         """Log-likelihood, eq. (10) x ``temper``, per row of theta; -inf where simulation failed.
 
@@ -172,9 +185,9 @@ class Problem:
         theta = np.atleast_2d(np.asarray(theta, dtype=float))
         self.n_evaluations += theta.shape[0]
         sigma = theta[:, -1]
-        r = self.predict(theta)[:, self.samples] - self.observed
+        sse, ok = self.residual_sums(theta)
         n = self.n_data
         with np.errstate(invalid="ignore", divide="ignore"):
-            ll = -0.5 * n * np.log(2 * np.pi * sigma**2) - 0.5 * np.sum(r * r, axis=1) / sigma**2
-        ll[~(sigma > 0) | ~np.isfinite(ll)] = -np.inf
+            ll = -0.5 * n * np.log(2 * np.pi * sigma**2) - 0.5 * sse / sigma**2
+        ll[~(sigma > 0) | ~ok | ~np.isfinite(ll)] = -np.inf
         return self.temper * ll if self.temper != 1.0 else ll

@@ -2,13 +2,45 @@
 
 ``linear`` is the paper's M1 (f = 0, "Bayesian equivalent linearisation"); ``tanh`` is M2
 (f = F_c tanh(beta z')). The diagnosis extends a structure with further terms by name.
+A structure's :class:`Layout` says where each parameter sits in the packed parameter vector
+that the simulator takes: eq. (1)'s M, m, k, c_m, then each term's parameters in order.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from harvester.model.terms import Layout, term
+from harvester.model.terms import BASE_PARAMETERS, Term, term
+
+
+@dataclass(frozen=True)
+class Layout:
+    """The packed parameter vector of a composition of terms (base parameters first)."""
+
+    terms: tuple[Term, ...]
+    parameter_names: tuple[str, ...]
+    n_states: int
+
+    @classmethod
+    def of(cls, term_names: tuple[str, ...] | list[str]) -> "Layout":
+        terms = tuple(term(n) for n in term_names)
+        if len({t.name for t in terms}) != len(terms):
+            raise ValueError(f"terms {list(term_names)} repeat a term")
+        if sum(t.kind == "coupling" for t in terms) > 1:
+            raise ValueError(f"terms {list(term_names)} hold more than one coupling")
+        names = [p.name for p in BASE_PARAMETERS] + [p for t in terms for p in t.parameter_names]
+        if len(set(names)) != len(names):
+            raise ValueError(f"terms {list(term_names)} repeat a parameter name")
+        return cls(terms, tuple(names), 2 + sum(t.n_states for t in terms))
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The terms' names, in order."""
+        return tuple(t.name for t in self.terms)
+
+    def index(self, name: str) -> int:
+        return self.parameter_names.index(name)
+
 
 #: The paper's structures (term names added to the base eq. 1).
 STRUCTURES: dict[str, tuple[str, ...]] = {

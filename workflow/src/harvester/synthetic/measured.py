@@ -19,7 +19,7 @@ import pandas as pd
 from scipy import signal
 
 from harvester.study.paper import TABLE1_KNOWN, TABLE5
-from harvester.model.terms import Layout
+from harvester.model.structures import Layout
 from harvester.data.signals import lowpass
 from harvester.model.simulate import simulate
 

@@ -1,0 +1,60 @@
+"""The physics library's registry: a term is one complete object, refused when it is not."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from harvester.model import codegen
+from harvester.model.structures import Layout
+from harvester.model.terms import BASE_PARAMETERS, TERMS, Parameter, check_term, register
+
+
+def test_every_term_is_complete_and_in_a_file_named_for_it():
+    for name, t in TERMS.items():
+        check_term(t)
+        assert t.source.endswith(f"{name}.py")
+
+
+def test_parameter_names_are_unique_across_the_library():
+    names = [p.name for p in BASE_PARAMETERS] + [p for t in TERMS.values()
+                                                 for p in t.parameter_names]
+    assert len(names) == len(set(names))
+
+
+@pytest.mark.parametrize("change, message", [
+    (dict(kind="spring"), "kind"),
+    (dict(equation=""), "no equation"),
+    (dict(description=""), "no description"),
+    (dict(n_states=1), "state_rates"),
+    (dict(parameters=(Parameter("F_x", "", 1.0, 1.0),)), "unit"),
+    (dict(parameters=(Parameter("_F", "N", 1.0, 1.0, 0.0, "d"),)), "identifiers"),
+    (dict(parameters=(Parameter("F_x", "N", 1.0, 0.0, 0.0, "d"),)), "prior sd"),
+])
+def test_registry_refuses_an_incomplete_term(change, message):
+    bad = replace(TERMS["coulomb_friction"], name="bad_term", **change)
+    with pytest.raises(ValueError, match=message):
+        register(bad)
+    assert "bad_term" not in TERMS
+
+
+def test_registry_refuses_a_parameter_name_taken_by_another_term():
+    clash = replace(TERMS["coulomb_friction"], name="clash_term")
+    with pytest.raises(ValueError, match="already taken"):
+        register(clash)
+
+
+def test_generated_kernel_is_the_same_module_for_the_same_structure():
+    a = codegen.kernel(("tanh_friction",), "base")
+    assert codegen.kernel(("tanh_friction",), "base") is a
+    assert codegen.source(("tanh_friction",), "base") == codegen.source(("tanh_friction",),
+                                                                        "base")
+    assert "F_c * " not in codegen.source(("tanh_friction",), "base")  # the law is the term's
+
+
+def test_layout_refuses_a_repeated_term_and_two_couplings():
+    with pytest.raises(ValueError, match="repeat"):
+        Layout.of(["tanh_friction", "tanh_friction"])
+    assert Layout.of(["backlash"]).n_states == 4
+    assert Layout.of([]).parameter_names == ("M", "m", "k", "c_m")
+    assert np.all([Layout.of([n]).names == (n,) for n in TERMS])

@@ -1,0 +1,285 @@
+"""Compiled kernels per model structure: the integrator, generated once and cached on disk.
+
+A structure (a tuple of term names) and a driver (how the input enters) get one generated
+Python module holding
+
+``rhs``        the right-hand side of eq. (1) with the structure's terms, written as straight
+               code: each term's force law (``model/terms/<name>.py``) is compiled into it, so
+               no term is chosen while integrating;
+``integrate``  classical RK4 over a block of particles that share a sub-step count, with the
+               particles innermost (struct of arrays) so that the compiler vectorises the
+               loop over them (4 doubles per AVX2 instruction);
+
+``integrate`` releases the GIL: ``harvester.model.simulate`` runs the blocks of a population
+in a pool of threads, each block followed at once by its acquisition (compiled once for every
+structure in ``harvester.model.acquisition``), so a new structure compiles only ``rhs`` and
+``integrate`` (about a second).
+
+Drivers: ``base`` (input the base acceleration y'', drive -m y''), ``force`` (a force on the
+mass, base fixed), ``servo`` (a digital position loop computes the force at every sample from
+the simulated position, held over the sample: the EMPS drive).
+
+The module's source is written to a cache directory (``HARVESTER_CACHE`` or
+``~/.cache/harvester/kernels``) under a name that hashes the generated text and the source of
+every file it depends on (the term files, ``fastmath``, ``acquisition`` and this generator),
+and imported from there, so that Numba's own cache (``cache=True``) keeps the machine code
+between processes and a change of any term recompiles what uses it.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import os
+import sys
+import tempfile
+import threading
+from pathlib import Path
+from types import ModuleType
+
+import numba as nb
+
+from harvester.model.terms import Term, term
+
+#: States beyond this magnitude count as a failed (unstable) simulation.
+BLOW_UP = 1.0e6
+DRIVERS = ("base", "force", "servo")
+
+_compiled: dict[tuple[str, str], object] = {}
+_modules: dict[tuple[tuple[str, ...], str], ModuleType] = {}
+_lock = threading.Lock()
+
+
+def compiled(term_name: str, function: str):
+    """A term's law (``force``, ``state_rates``, ``masses``) compiled for inlining."""
+    key = (term_name, function)
+    if key not in _compiled:
+        fn = getattr(term(term_name), function)
+        _compiled[key] = nb.njit(inline="always", error_model="numpy", cache=True)(fn)
+    return _compiled[key]
+
+
+# --------------------------------------------------------------------------- the source
+
+
+def _names(terms: tuple[Term, ...]) -> tuple[list[str], list[str]]:
+    """(parameter names, state names) of a structure in layout order."""
+    params = ["M", "m", "k", "c_m"] + [p for t in terms for p in t.parameter_names]
+    states = ["z", "v"]
+    for i, t in enumerate(terms):
+        states += [f"_x{i}_{j}" for j in range(t.n_states)]
+    return params, states
+
+
+def _rhs_source(terms: tuple[Term, ...], driver: str) -> str:
+    """The right-hand side: (a, d state / dt ...) of one particle."""
+    params, states = _names(terms)
+    lines = [f"def rhs(_u, {', '.join(states)}, {', '.join(params)}):",
+             "    _M = M", "    _m = m"]
+    state_of = {}
+    k = 2
+    for i, t in enumerate(terms):
+        state_of[i] = states[k:k + t.n_states]
+        k += t.n_states
+    args = {i: ", ".join(t.parameter_names) for i, t in enumerate(terms)}
+    for i, t in enumerate(terms):
+        if t.kind == "inertia":
+            lines.append(f"    _M, _m = _masses{i}(_M, _m, {args[i]})")
+    if driver == "base":
+        lines += ["    _drive = -_m * _u", "    _yb = _u"]
+    else:
+        lines += ["    _drive = _u", "    _yb = 0.0"]
+    coupling = [i for i, t in enumerate(terms) if t.kind == "coupling"]
+    lines.append(f"    _w = v - {state_of[coupling[0]][1]}" if coupling else "    _w = v")
+    lines += ["    _f_screw = c_m * _w", "    _f_mass = k * z", "    _f_mode = 0.0"]
+    for i, t in enumerate(terms):
+        st = "".join(f"{s}, " for s in state_of[i])
+        if t.kind == "screw":
+            lines.append(f"    _f_screw += _force{i}(_w, {st}{args[i]})")
+        elif t.kind == "mass":
+            lines.append(f"    _f_mass += _force{i}(z, {args[i]})")
+        elif t.kind == "mode":
+            lines.append(f"    _f_mode += _force{i}({st}{args[i]})")
+    derivs = {}
+    if coupling:
+        i = coupling[0]
+        d, dd = state_of[i]
+        lines += [f"    _fb = _force{i}({d}, {dd}, _M, _m, {args[i]})",
+                  "    _j_eq = max(_M - _m, 1e-6)",
+                  "    _a = (_drive - _f_mass - _fb + _f_mode) / _m",
+                  f"    _d{dd} = _a - (_fb - _f_screw) / _j_eq"]
+        derivs[d], derivs[dd] = dd, f"_d{dd}"
+    else:
+        lines.append("    _a = (_drive - _f_screw - _f_mass + _f_mode) / _M")
+    for i, t in enumerate(terms):
+        if t.kind == "screw" and t.n_states:
+            out = ", ".join(f"_d{s}" for s in state_of[i])
+            lines.append(f"    {out} = _rates{i}(_w, {''.join(f'{s}, ' for s in state_of[i])}"
+                         f"{args[i]})")
+            derivs.update({s: f"_d{s}" for s in state_of[i]})
+        elif t.kind == "mode":
+            u0, u1 = state_of[i]
+            lines.append(f"    _d{u0}, _d{u1} = _rates{i}({u0}, {u1}, _a, _yb, {args[i]})")
+            derivs.update({u0: f"_d{u0}", u1: f"_d{u1}"})
+    derivs["z"], derivs["v"] = "v", "_a"
+    lines.append("    return _a, " + ", ".join(derivs[s] for s in states))
+    return "\n".join(lines)
+
+
+def _step_source(terms: tuple[Term, ...], driver: str) -> str:
+    """The body of one RK4 step of particle c (indented for the loop it sits in)."""
+    params, states = _names(terms)
+    n = len(states)
+    p_args = ", ".join(f"p_{p}[c]" for p in params)
+    body = [f"y{j} = x{j}[c]" for j in range(n)]
+    u = {"a": "ua", "b": "ub", "c": "uc"} if driver != "servo" else \
+        {"a": "uu[c]", "b": "uu[c]", "c": "uu[c]"}
+
+    def call(k, inp, scale):
+        st = ", ".join(f"y{j}" if scale is None else f"y{j} + {scale} * k{k - 1}[{j + 1}]"
+                       for j in range(n))
+        return f"k{k} = rhs({inp}, {st}, {p_args})"
+
+    body += [call(1, u["a"], None), "row[c] = k1[0]",
+             call(2, u["b"], "half"), call(3, u["b"], "half"), call(4, u["c"], "h")]
+    body += [f"x{j}[c] = y{j} + sixth * (k1[{j + 1}] + 2.0 * k2[{j + 1}] + 2.0 * k3[{j + 1}]"
+             f" + k4[{j + 1}])" for j in range(n)]
+    return "\n".join(body)
+
+
+def _integrate_source(terms: tuple[Term, ...], driver: str) -> str:
+    params, states = _names(terms)
+    n = len(states)
+    ind = " " * 16
+    load = "\n".join(f"    p_{p} = P[{j}]" for j, p in enumerate(params))
+    init = "\n".join(f"    x{j} = np.zeros(C)" for j in range(n))
+    check = " and ".join(f"abs(x{j}[c]) < BLOW_UP" for j in range(n))
+    reset = "; ".join(f"x{j}[c] = 0.0" for j in range(n))
+    step = "\n".join(ind + line for line in _step_source(terms, driver).splitlines())
+    out_rhs = ", ".join(f"x{j}[c]" for j in range(n)) + ", " + \
+        ", ".join(f"p_{p}[c]" for p in params)
+    if driver == "servo":
+        head = ("def integrate(qg, dist, dt, q0, gtau, kp, kv, n_sub, h, P, out_acc, out_z, "
+                "out_v, out_f, ok):")
+        prologue = ("    n = qg.shape[0]\n    uu = np.empty(C)\n    q1 = np.empty(C)\n"
+                    "    q2 = np.empty(C)\n    for c in range(C):\n"
+                    "        q1[c] = q0\n        q2[c] = q0\n        x0[c] = q0")
+        sample = ("        for c in range(C):\n"
+                  "            q = x0[c]\n"
+                  "            uu[c] = gtau * (kv * (kp * (qg[i] - q) - (q - q2[c]) / (2.0 * dt))"
+                  " + dist[i])\n"
+                  "            q2[c] = q1[c]\n            q1[c] = q\n"
+                  "        if out_f.shape[0] > 0:\n"
+                  "            for c in range(C):\n"
+                  "                out_f[i, c] = uu[c]\n")
+        inputs = ""
+        last_u = "uu[c]"
+    else:
+        head = "def integrate(u, n_sub, h, P, out_acc, out_z, out_v, ok):"
+        prologue = "    n = u.shape[0]"
+        sample = ""
+        inputs = ("            ua = ui + du * s\n            ub = ua + 0.5 * du\n"
+                  "            uc = ua + du\n")
+        last_u = "u[n - 1]"
+    return f'''{head}
+    C = P.shape[1]
+{load}
+{init}
+{prologue}
+    scratch = np.empty(C)
+    half = 0.5 * h
+    sixth = h / 6.0
+    for i in range(n):
+{sample}        if out_z.shape[0] > 0:
+            for c in range(C):
+                out_z[i, c] = x0[c]
+        if out_v.shape[0] > 0:
+            for c in range(C):
+                out_v[i, c] = x1[c]
+        acc_row = out_acc[i] if out_acc.shape[0] > 0 else scratch
+        if i == n - 1:
+            for c in range(C):
+                acc_row[c] = rhs({last_u}, {out_rhs})[0]
+            break
+        {"ui = u[i]" if driver != "servo" else "pass"}
+        {"du = (u[i + 1] - ui) / n_sub" if driver != "servo" else ""}
+        for s in range(n_sub):
+{inputs}            row = acc_row if s == 0 else scratch
+            for c in range(C):
+{step}
+        for c in range(C):
+            if not ({check}):
+                ok[c] = False
+                {reset}
+'''
+
+
+def source(terms: tuple[str, ...], driver: str) -> str:
+    """The generated module's text for a structure and a driver."""
+    if driver not in DRIVERS:
+        raise ValueError(f"driver must be one of {DRIVERS}, got {driver!r}")
+    objs = tuple(term(n) for n in terms)
+    imports = []
+    for i, t in enumerate(objs):
+        for fn, local in (("force", "_force"), ("state_rates", "_rates"), ("masses", "_masses")):
+            if getattr(t, fn) is not None:
+                imports.append(f'{local}{i} = compiled("{t.name}", "{fn}")')
+    jit = '@nb.njit(error_model="numpy", cache=True'
+    return "\n".join([
+        f'"""Generated by harvester.model.codegen: structure ({", ".join(terms) or "linear"}),'
+        f' driver {driver}. Do not edit."""',
+        "import numba as nb", "import numpy as np", "",
+        "from harvester.model.codegen import BLOW_UP, compiled", "", *imports, "", "",
+        f'{jit}, inline="always")', _rhs_source(objs, driver), "", "",
+        f"{jit}, nogil=True)", _integrate_source(objs, driver)])
+
+
+# --------------------------------------------------------------------------- the cache
+
+
+def cache_dir() -> Path:
+    """Where generated kernels and their machine code live."""
+    root = os.environ.get("HARVESTER_CACHE") or Path.home() / ".cache" / "harvester"
+    return Path(root) / "kernels"
+
+
+def _dependencies(terms: tuple[str, ...]) -> list[Path]:
+    here = Path(__file__).parent
+    deps = [Path(__file__), here / "fastmath.py", here / "acquisition.py",
+            here / "terms" / "__init__.py"]
+    return deps + [Path(term(n).source) for n in terms]
+
+
+def _digest(text: str, terms: tuple[str, ...]) -> str:
+    h = hashlib.sha256(text.encode())
+    for path in _dependencies(terms):
+        h.update(path.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def _import(path: Path, name: str) -> ModuleType:
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def kernel(terms: tuple[str, ...], driver: str = "base") -> ModuleType:
+    """The compiled kernel module of a structure (generated and imported once per process)."""
+    key = (tuple(terms), driver)
+    with _lock:
+        if key in _modules:
+            return _modules[key]
+        text = source(key[0], driver)
+        name = f"harvester_kernel_{driver}_{_digest(text, key[0])}"
+        directory = cache_dir()
+        directory.mkdir(parents=True, exist_ok=True)
+        path = directory / f"{name}.py"
+        if not path.exists() or path.read_text() != text:
+            fd, tmp = tempfile.mkstemp(dir=directory, suffix=".tmp")
+            with os.fdopen(fd, "w") as f:
+                f.write(text)
+            os.replace(tmp, path)
+        _modules[key] = _import(path, name)
+        return _modules[key]

@@ -1,0 +1,220 @@
+"""The library of physics: named terms that a model structure composes.
+
+Every structure shares the base equation of motion, eq. (1) of Green et al. (2015),
+
+    M z'' + c_m z' + k z + f(z') = -m y'',        z = x - y,
+
+with c_m the translational viscous coefficient (N s/m). A term adds one named effect. Each
+term is one object in one file of this package (``model/terms/<name>.py``, a module-level
+``TERM``), holding everything about it: its parameters with units and priors, its equation,
+its force law (plain arithmetic that ``harvester.model.codegen`` compiles into each
+structure's kernel), the bound on its stiffness that sets the integrator's step, and its
+description. The registry (:data:`TERMS`) collects every module of the package and refuses a
+term that lacks any of these (:func:`register`); ``docs/adding-a-term.md`` walks through
+adding one.
+
+Sign convention: a positive force opposes positive z or z' (it is added to the left-hand side
+of eq. 1). Kinds of term and the signature of their force law:
+
+``screw``     f = force(w, *params) on the ball-screw side, w its velocity (w = z' unless
+              the structure has a ``coupling``); with internal states h:
+              f = force(w, *h, *params), h' = state_rates(w, *h, *params)
+``mass``      f = force(z, *params) on the mass, a function of its displacement
+``inertia``   (M, m) = masses(M, m, *params): changes the effective and oscillating masses
+``mode``      a secondary mode with states (u, u'): f = force(u, u', *params) on the mass,
+              (u', u'') = state_rates(u, u', a, y'', *params), a the mass's z''
+``coupling``  a dead zone between the mass and the screw-side inertia (states d, d'):
+              f_b = force(d, d', M, m, *params) transmitted between them
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+#: Regularising velocity (m/s) for sign-like friction laws: sgn(v) ~ tanh(v / V_EPS).
+V_EPS = 1.0e-3
+#: Largest velocity (m/s) and displacement (m) assumed when bounding stiffness for step control.
+V_BOUND = 1.0
+Z_BOUND = 0.3
+
+KINDS = ("screw", "mass", "inertia", "mode", "coupling")
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A physical parameter with its unit and default prior (Gaussian, truncated below)."""
+
+    name: str
+    unit: str
+    prior_mean: float
+    prior_sd: float
+    lower: float | None = 0.0
+    description: str = ""
+
+
+@dataclass(frozen=True)
+class RateBound:
+    """A term's share of the bound on the fastest rate of the equations (``step_rates``):
+    damping added to d force / d velocity (N s/m), stiffness added to d force / d
+    displacement (N/m), and a rate of its own (1/s), each per particle."""
+
+    damping: np.ndarray | float = 0.0
+    stiffness: np.ndarray | float = 0.0
+    rate: np.ndarray | float = 0.0
+
+
+@dataclass(frozen=True)
+class Motion:
+    """What a rate bound may know of the motion: the effective and oscillating masses (kg,
+    after any ``inertia`` term) and the largest velocity (m/s) and displacement (m)."""
+
+    mass: np.ndarray
+    m_osc: np.ndarray
+    v_bound: float = V_BOUND
+    z_bound: float = Z_BOUND
+
+
+@dataclass(frozen=True)
+class Term:
+    """A named effect: parameters, equation, compiled force law and its step bound.
+
+    ``force`` (and ``state_rates``, ``masses``) are plain functions of floats, in the
+    signature of the term's ``kind`` (module docstring), using only arithmetic and
+    ``harvester.model.fastmath`` so that the compiler vectorises them. ``rate_bound(p,
+    motion)`` gets the parameters as a dict of arrays (one value per particle) and returns a
+    :class:`RateBound`. ``refines``: a refinement of one of these terms' laws, meaningless
+    without one of them (a Stribeck excess is over a sliding friction): a candidate only where
+    one is in the structure. ``n_states``: internal states the term adds.
+    """
+
+    name: str
+    kind: str
+    parameters: tuple[Parameter, ...]
+    equation: str
+    description: str
+    force: Callable
+    rate_bound: Callable[[dict, Motion], RateBound]
+    n_states: int = 0
+    state_rates: Callable | None = None
+    masses: Callable | None = None
+    refines: tuple[str, ...] = ()
+    source: str = field(default="", compare=False)  # the file that defines the term
+
+    @property
+    def parameter_names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self.parameters)
+
+
+BASE_PARAMETERS: tuple[Parameter, ...] = (
+    Parameter("M", "kg", 12.8, 1.0, 0.0, "effective mass m + J (2 pi / l)^2, eq. (2)"),
+    Parameter("m", "kg", 8.0, 0.5, 0.0, "oscillating mass"),
+    Parameter("k", "N/m", 250.0, 25.0, 0.0, "spring stiffness"),
+    Parameter("c_m", "N s/m", 170.0, 50.0, 0.0, "translational viscous damping b_m, eq. (3)"),
+)
+
+#: Laws of sliding friction (Dahl's saturates to Coulomb's): what a Stribeck excess or a
+#: direction-dependent part refines.
+SLIDING_FRICTION: tuple[str, ...] = ("tanh_friction", "coulomb_friction", "hysteresis")
+
+
+def check_term(t: Term) -> None:
+    """ValueError naming what a term lacks (the registry's conditions)."""
+    problems = []
+    if t.kind not in KINDS:
+        problems.append(f"kind {t.kind!r} is not one of {KINDS}")
+    for what in ("equation", "description"):
+        if not getattr(t, what):
+            problems.append(f"no {what}")
+    if not callable(t.force) or not callable(t.rate_bound):
+        problems.append("force and rate_bound must be functions")
+    needs_rates = t.kind == "mode" or (t.kind == "screw" and t.n_states > 0)
+    if needs_rates and not callable(t.state_rates):
+        problems.append("a term with internal states needs state_rates")
+    if t.kind == "inertia" and not callable(t.masses):
+        problems.append("an inertia term needs masses")
+    if t.kind in ("mode", "coupling") and t.n_states != 2:
+        problems.append(f"a {t.kind} term has 2 states, not {t.n_states}")
+    for p in t.parameters:
+        if not p.unit or not p.description or not p.prior_sd > 0:
+            problems.append(f"parameter {p.name} needs a unit, a description and a prior sd > 0")
+    names = [p.name for p in t.parameters]
+    bad = [n for n in names if not n.isidentifier() or n.startswith("_")]
+    if bad:
+        problems.append(f"parameter names {bad} must be identifiers not starting with '_'")
+    if len(set(names)) != len(names):
+        problems.append("repeated parameter names")
+    if problems:
+        raise ValueError(f"physics term {t.name!r} ({t.source}): " + "; ".join(problems))
+
+
+#: All terms by name (filled by :func:`register` from the modules of this package).
+TERMS: dict[str, Term] = {}
+
+
+def register(t: Term) -> Term:
+    """Add a term to the library after :func:`check_term`; a name may be registered once."""
+    check_term(t)
+    clash = [p for p in t.parameter_names for o in TERMS.values() if o.name != t.name
+             and p in o.parameter_names] + [p for p in t.parameter_names
+                                            if p in {b.name for b in BASE_PARAMETERS}]
+    if clash:
+        raise ValueError(f"physics term {t.name!r}: parameter names {sorted(set(clash))} are "
+                         "already taken (names must be unique across the library)")
+    if t.name in TERMS and TERMS[t.name] is not t:
+        raise ValueError(f"physics term {t.name!r} is registered twice")
+    TERMS[t.name] = t
+    return t
+
+
+def _discover() -> None:
+    for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
+        module = importlib.import_module(f"{__name__}.{info.name}")
+        t = getattr(module, "TERM", None)
+        if not isinstance(t, Term):
+            raise ValueError(f"{module.__file__} defines no TERM (a harvester.model.terms.Term)")
+        if t.name != info.name:
+            raise ValueError(f"{module.__file__} defines the term {t.name!r}; the file must be "
+                             f"named for it ({t.name}.py)")
+        register(t)
+
+
+def term(name: str) -> Term:
+    """Look up a term by name, with the list of known names on error."""
+    try:
+        return TERMS[name]
+    except KeyError:
+        raise KeyError(f"unknown physics term {name!r}; known: {sorted(TERMS)}") from None
+
+
+def step_rates(terms: tuple[Term, ...], params: dict[str, np.ndarray],
+               v_bound: float | None = None) -> np.ndarray:
+    """Per-particle bound on the fastest rate (1/s) of the equations of motion.
+
+    ``params`` maps every parameter of the base and the terms to an array (one value per
+    particle); ``v_bound`` (m/s): the largest velocity assumed for velocity-dependent rates
+    (Dahl relaxation, quadratic damping); None: V_BOUND. A caller that knows the motion gives
+    a tighter one. The largest of: damping rate (d force / d velocity) / mass, natural
+    frequency sqrt(stiffness / mass) of every spring, contact and mode, and each term's own
+    rate. Used only to choose the integrator's sub-step.
+    """
+    mass, m_osc = np.abs(params["M"]), np.abs(params["m"])
+    for t in terms:
+        if t.masses is not None:
+            mass, m_osc = t.masses(mass, m_osc, *(params[n] for n in t.parameter_names))
+    motion = Motion(np.maximum(mass, 1e-3), m_osc, V_BOUND if v_bound is None else v_bound)
+    damp, stiff = np.abs(params["c_m"]).copy(), np.abs(params["k"]).copy()
+    rate = np.zeros_like(damp)
+    for t in terms:
+        b = t.rate_bound({n: params[n] for n in t.parameter_names}, motion)
+        damp = damp + b.damping
+        stiff = stiff + b.stiffness
+        rate = np.maximum(rate, b.rate)
+    return np.maximum.reduce([rate, damp / motion.mass, np.sqrt(stiff / motion.mass)])
+
+
+_discover()

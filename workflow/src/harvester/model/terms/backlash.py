@@ -1,0 +1,58 @@
+"""A dead zone (backlash) between the mass and the screw-side inertia J = M - m.
+
+States: d, the relative displacement of the mass and the screw side, and d'. The coupling
+force is F_b = k_backlash dz(d, gap) + c_b d' while in contact (compressive only), dz the
+dead-zone function, c_b at damping ratio BACKLASH_ZETA on the reduced mass m J / (m + J).
+The mass obeys m z'' = -m y'' - k z - (mass forces) - F_b and the screw side
+J r'' = F_b - c_m r' - f(r'), d = z - r.
+
+The contact's damping: without it (a Hunt-Crossley law, damping ~ penetration) the contact
+rang and chattered; at zero clearance the coupling was an undamped mode, and the
+log-likelihood of a record of the baseline itself fell by thousands at the library's
+stiffness (measured).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from harvester.model.terms import Motion, Parameter, RateBound, Term
+
+#: Damping ratio of the contact (Kelvin-Voigt, on the reduced mass m J / (m + J)).
+BACKLASH_ZETA = 0.5
+
+
+def force(d, dd, M, m, gap_backlash, k_backlash):
+    """Coupling force F_b (N) at relative displacement d (m) and velocity dd (m/s)."""
+    j_eq = max(M - m, 1e-6)
+    c_b = 2.0 * BACKLASH_ZETA * np.sqrt(k_backlash * m * j_eq / (m + j_eq))
+    if d > gap_backlash:
+        return max(k_backlash * (d - gap_backlash) + c_b * dd, 0.0)
+    if d < -gap_backlash:
+        return min(k_backlash * (d + gap_backlash) + c_b * dd, 0.0)
+    return 0.0
+
+
+def rate_bound(p: dict, motion: Motion) -> RateBound:
+    """Eight times the contact's natural frequency on the reduced mass: the contact switches
+    on and off and RK4 drops to first order at each touch (x4 left 1.2 % error in z'' through
+    a 20 Hz low-pass in a rattling case, x8 0.3 %)."""
+    m = np.maximum(np.abs(motion.m_osc), 1e-3)
+    j = np.maximum(motion.mass - m, 1e-3)
+    reduced = m * j / (m + j)
+    return RateBound(rate=8.0 * np.sqrt(np.abs(p["k_backlash"]) / reduced))
+
+
+TERM = Term(
+    name="backlash", kind="coupling", n_states=2,
+    parameters=(
+        Parameter("gap_backlash", "m", 1e-5, 1e-5, 0.0,
+                  "half dead zone in the screw-nut coupling (axial play of an unloaded ball "
+                  "nut: a few to tens of micrometres)"),
+        Parameter("k_backlash", "N/m", 1e7, 1e7, 1e6,
+                  "axial contact stiffness of the screw-nut coupling (ball nuts: 1e7-1e9)"),
+    ),
+    equation="coupling force F_b = k_backlash dz(d, gap) + c_b d' in contact (compressive "
+             "only), c_b at damping ratio 0.5 on m J / (m + J); J r'' = F_b - c_m r' - f(r')",
+    description="dead zone between the mass and the screw-side inertia",
+    force=force, rate_bound=rate_bound, source=__file__)

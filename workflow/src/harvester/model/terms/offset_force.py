@@ -1,0 +1,25 @@
+"""A constant force on the mass (gravity, a cable, a sensor bias): f = F_offset.
+"""
+
+from __future__ import annotations
+
+
+from harvester.model.terms import Motion, Parameter, RateBound, Term
+
+
+def force(z, F_offset):
+    """f = F_offset (N), whatever the displacement."""
+    return F_offset + 0.0 * z
+
+
+def rate_bound(p: dict, motion: Motion) -> RateBound:
+    """A constant force adds no rate."""
+    return RateBound()
+
+
+TERM = Term(
+    name="offset_force", kind="mass",
+    parameters=(Parameter("F_offset", "N", 0.0, 5.0, None,
+                          "constant force (gravity, cable, bias)"),),
+    equation="f = F_offset", description="constant force offset",
+    force=force, rate_bound=rate_bound, source=__file__)
