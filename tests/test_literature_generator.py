@@ -1,0 +1,361 @@
+"""The literature-form generator (harvester.synthetic.literature): forms in their limits,
+integrator convergence against a tight implicit reference, calibration, reproducibility, the
+DAQ's anti-alias decimator and the files it writes."""
+
+from __future__ import annotations
+
+import ast
+import itertools
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+from harvester.synthetic import literature as L
+from scipy.integrate import solve_ivp
+
+LIBRARY_TERMS = {"coulomb_friction", "tanh_friction", "stribeck_friction", "asymmetric_friction",
+                 "quadratic_damping", "cubic_stiffness", "end_stop", "backlash", "hysteresis",
+                 "unmodelled_mode", "inertia_error", "offset_force"}
+NOISE = 0.09
+FS = 256.0
+
+#: A fixed, moderate device for the reference comparisons (2 Hz, friction 20 % of m max|y''|).
+DEVICE = L.Device(M=2.0, m=1.5, k=2.0 * (2 * np.pi * 2.0) ** 2, c=2 * 0.03 * np.sqrt(
+    2.0 * (2 * np.pi * 2.0) ** 2 * 2.0), F_c=1.2, v_t=0.01, friction_form="tanh",
+    transition_ratio=0.1, f_n=2.0, zeta=0.03, peak_base_acc=4.0)
+
+
+def _setup(duration_s: float = 2.0, device: L.Device = DEVICE, seed: int = 3):
+    """(time base, run, context) of a short record of ``device``."""
+    tb = L.TimeBase(FS, round(duration_s * FS))
+    exc = L.draw_excitation(np.random.default_rng(seed), device, tb.period, duration_s, FS)
+    run = L._Run(exc, tb)
+    _, _, z, v = run.output(L.NONE, device.params(), 2, internal=True)
+    return tb, run, L.Context.of(device, FS, z, v, L._internal_window(tb))
+
+
+def _output(run, tb, kind, p, n_sub=2):
+    return run.output(kind, p, n_sub)
+
+
+# --------------------------------------------------------------------------- registry
+
+def test_registry_names_families_and_citations():
+    families = {}
+    for name, scen in L.SCENARIOS.items():
+        assert scen.name == name and scen.citation and scen.form and scen.description
+        assert set(scen.correct_names) <= LIBRARY_TERMS
+        assert set(scen.related_names) <= LIBRARY_TERMS
+        assert not set(scen.correct_names) & set(scen.related_names)
+        families.setdefault(scen.family, []).append(name)
+    counts = {f: len(v) for f, v in families.items()}
+    assert counts["pre-sliding friction with memory"] == 3
+    assert counts["stiction/breakaway"] == 3
+    assert counts["end stop contact"] == 3
+    assert counts["hardening spring"] == 2
+    assert counts["flexible mount / secondary mode"] == 2
+    assert counts["mass error"] == 2
+    assert counts["fluid damping"] == 2
+    assert counts["direction-dependent friction"] == 1
+    assert L.SCENARIOS["none"].correct_names == ()
+
+
+def test_module_stands_alone():
+    tree = ast.parse(Path(L.__file__).read_text())
+    imported = {a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
+    imported |= {n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) and n.module}
+    assert not any(m.split(".")[0] == "harvester" for m in imported)
+
+
+# --------------------------------------------------------------------------- forms in their limits
+
+def test_every_effect_at_zero_strength_is_the_baseline():
+    tb, run, ctx = _setup()
+    base = _output(run, tb, L.NONE, DEVICE.params())
+    rng = np.random.default_rng(0)
+    for name, scen in L.SCENARIOS.items():
+        if name == "none" or scen.family in ("end stop contact",
+                                              "flexible mount / secondary mode"):
+            continue  # a rigid mount / massless mode / grazing stop: tested apart
+        kind, p = L.effect_params(DEVICE, scen.effect(ctx, scen.draw_shape(rng, ctx), 0.0))
+        out = _output(run, tb, kind, p)
+        # equal up to the finer sub-steps taken near a stop or the stick band
+        assert np.max(np.abs(out - base)) < 1e-7, name
+
+
+def test_mode_and_mount_vanish_with_their_strength():
+    tb, run, ctx = _setup()
+    base = _output(run, tb, L.NONE, DEVICE.params())
+    win = tb.window
+    for name in ("secondary_mode", "flexible_mount"):
+        scen = L.SCENARIOS[name]
+        shape = scen.draw_shape(np.random.default_rng(1), ctx)
+        lo, _ = scen.bounds(ctx, shape)
+        small = lo if name == "flexible_mount" else 1e-6
+        rms = [L._rms((_output(run, tb, *L.effect_params(DEVICE, scen.effect(
+            ctx, shape, s))) - base)[win]) for s in (small, small / 4)]
+        assert rms[1] < 0.3 * rms[0], name  # shrinks with the strength (linearly or faster)
+
+
+def test_stiff_bristles_slide_like_coulomb_after_a_presliding_distance():
+    """LuGre, Dahl (alpha 1) and Bouc-Wen (n 1): driven at constant velocity from rest, the
+    friction reaches 99 % of F_c within 10 F_c / stiffness, i.e. Coulomb sliding as the
+    stiffness grows (Canudas de Wit et al. 1995; Dahl 1968)."""
+    v, f_c = 0.01, DEVICE.F_c
+    for stiffness in (1e3, 1e6):
+        for kind, extra in ((L.LUGRE, [0.0]), (L.DAHL, [1.0]), (L.BOUC_WEN, [1.0, 1.0, 0.0])):
+            p = DEVICE.params()
+            p[L.E: L.E + 2 + len(extra)] = [1.0, stiffness, *extra]
+            x = np.array([0.0, v, 0.0, 0.0, 0.0])
+            steps = 200
+            h = 10.0 * f_c / stiffness / v / steps
+            for _ in range(steps):
+                L._relax(kind, p, x, h)
+            force = L._memory_force(kind, p, v, x[2])
+            assert 0.99 * f_c < force <= 1.0001 * f_c, (kind, stiffness, force)
+
+
+def test_stop_with_gap_beyond_the_motion_does_nothing():
+    tb, run, ctx = _setup()
+    base = _output(run, tb, L.NONE, DEVICE.params())
+    for kind, values in ((L.STOP_POWER, [1e7, 1.5, 0.0, 2 * ctx.z_max, 1e-3]),
+                         (L.STOP_KV, [1e7, 1.0, 100.0, 2 * ctx.z_max])):
+        p = DEVICE.params()
+        p[L.E: L.E + len(values)] = values
+        np.testing.assert_array_equal(_output(run, tb, kind, p), base)
+
+
+def test_karnopp_sticks_below_breakaway_and_slides_above():
+    """A constant base acceleration a0 after a 0.1 s ramp: Karnopp's element (breakaway
+    1.5 F_c = 1.8 N) holds the mass while m a0 < 1.8 N; the tanh law alone lets it creep."""
+    tb = L.TimeBase(FS, 256)
+    t = np.arange(2 * tb.n_int + 8) * tb.h_int / 2
+    ramp = np.clip(t / 0.1, 0.0, 1.0)
+    p = DEVICE.params()
+    p[L.E: L.E + 3] = [1.0, 1.5, 1e-3]
+    moved = {}
+    for a0 in (0.8, 1.6):  # m a0 = 1.2 N (below), 2.4 N (above)
+        for kind in (L.KARNOPP, L.NONE):
+            _, z, _ = L.simulate(kind, p, a0 * ramp, tb, 4)
+            moved[a0, kind] = np.max(np.abs(z))
+    assert moved[0.8, L.KARNOPP] == 0.0
+    assert moved[0.8, L.NONE] > 1e-3
+    assert moved[1.6, L.KARNOPP] > 1e-3
+
+
+def test_stribeck_and_asymmetric_force_laws():
+    p = DEVICE.params()
+    for delta in (1.0, 2.0):
+        p[L.E: L.E + 3] = [0.5, 0.02, delta]
+        f = L._friction(L.STRIBECK, p, 0.02, 0.0, 0.0)
+        assert f == pytest.approx(DEVICE.F_c * np.tanh(2.0) * (1 + 0.5 * np.exp(-1.0)))
+        assert L._friction(L.STRIBECK, p, 5.0, 0.0, 0.0) == pytest.approx(DEVICE.F_c, rel=1e-9)
+    p[L.E: L.E + 2] = [0.3, 0.005]
+    assert L._friction(L.ASYMMETRIC, p, 2.0, 0.0, 0.0) == pytest.approx(1.3 * DEVICE.F_c)
+    assert L._friction(L.ASYMMETRIC, p, -2.0, 0.0, 0.0) == pytest.approx(-0.7 * DEVICE.F_c)
+
+
+# --------------------------------------------------------------------------- integrator
+
+def _reference(kind, p, tb, run, t_end):
+    """z'' at the internal samples up to t_end by Radau (rtol 1e-10) on the full ODE, the
+    memory variable integrated as an ordinary state and the input summed exactly."""
+    memory = L.LUGRE <= kind <= L.BOUC_WEN
+    exc = run.excitation
+
+    def f(t, x):
+        xx, dx = np.append(x, p[L._VREF]), np.zeros(5)
+        L._rhs(kind, p, xx, float(exc.at(t)[0]), dx)
+        if memory:
+            rate_p, rate_q = L._memory_rates(kind, p, x[1], x[2])
+            dx[2] = rate_p - rate_q * x[2]
+        return dx[:4]
+
+    times = np.arange(int(t_end / tb.h_int)) * tb.h_int
+    sol = solve_ivp(f, (0.0, times[-1]), np.zeros(4), method="Radau", t_eval=times,
+                    rtol=1e-10, atol=1e-13)
+    assert sol.success
+    dx = np.zeros(5)
+    states = np.vstack([sol.y, np.full(times.size, p[L._VREF])])
+    return np.array([L._rhs(kind, p, states[:, i], float(exc.at(t)[0]), dx)
+                     for i, t in enumerate(times)])
+
+
+def _convergence(kind, values, t_end=1.0):
+    """RMS z'' error against the reference at 1, 2, 4, 8 sub-steps, and the sub-step count
+    the generator's criterion accepts (halving changes the output by <= CONVERGENCE_TOL x
+    the noise)."""
+    tb, run, _ = _setup()
+    p = DEVICE.params()
+    p[L.E: L.E + len(values)] = values
+    ref = _reference(kind, p, tb, run, t_end)
+    accs = [L.simulate(kind, p, run.grid, tb, n)[0][: ref.size] for n in (1, 2, 4, 8)]
+    errs = [L._rms(acc - ref) for acc in accs]
+    changes = [L._rms(b - a) for a, b in itertools.pairwise(accs)]
+    accepted = next(i for i, c in enumerate(changes + [0.0]) if c <= L.CONVERGENCE_TOL * NOISE)
+    return errs, accepted
+
+
+@pytest.mark.parametrize("kind,values", [
+    (L.NONE, []),
+    (L.LUGRE, [0.5, 1e4, 2 * 0.5 * np.sqrt(1e4 * 2.0)]),
+])
+def test_integrator_converges_to_the_radau_reference(kind, values):
+    """Errors shrink under step halving (RK4; the memory laws' splitting is ~2nd order) and
+    the accepted step's error is within twice the criterion (first order's worst case)."""
+    errs, accepted = _convergence(kind, values)
+    assert errs[accepted] <= 2 * L.CONVERGENCE_TOL * NOISE, (errs, accepted)
+    assert all(b < a for a, b in itertools.pairwise(errs)) or errs[0] < 1e-6 * NOISE, errs
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind,values", [
+    (L.DAHL, [0.7, 3e4, 1.5]),
+    (L.BOUC_WEN, [0.7, 3e4, 2.0, 0.7, 0.3]),
+    (L.STRIBECK, [1.0, 0.02, 2.0]),
+    (L.STOP_POWER, [1e6, 1.5, 0.0, 0.01, 1e-3]),
+    (L.SPRING_POWER, [5e4, 3.0]),
+    (L.DAMP_POWER, [20.0, 2.0]),
+    (L.MOUNT, [3.0, 3.0 * (2 * np.pi * 12.0) ** 2, 2 * 0.05 * 3.0 * 2 * np.pi * 12.0]),
+    (L.SECONDARY, [0.3, 0.3 * (2 * np.pi * 9.0) ** 2, 2 * 0.02 * 0.3 * 2 * np.pi * 9.0]),
+])
+def test_integrator_converges_for_every_smooth_form(kind, values):
+    errs, accepted = _convergence(kind, values)
+    assert errs[accepted] <= 2 * L.CONVERGENCE_TOL * NOISE, (errs, accepted)
+    assert errs[-1] < errs[0], errs
+
+
+def test_karnopp_converges_under_step_halving():
+    """Karnopp's force jumps at its stick band: the change under step halving shrinks."""
+    _, run, _ = _setup()
+    p = DEVICE.params()
+    p[L.E: L.E + 3] = [1.0, 1.5, 5e-3]
+    outs = [run.output(L.KARNOPP, p, n) for n in (1, 2, 4, 8)]
+    changes = [L._rms(b - a) for a, b in itertools.pairwise(outs)]
+    assert changes[-1] < 0.3 * changes[0] and changes[-1] < 1e-2 * NOISE, changes
+
+
+# --------------------------------------------------------------------------- acquisition
+
+def test_fir_decimator_passes_the_band_and_rejects_above_nyquist():
+    q, n_out = L.OVERSAMPLE, 2048
+    h = L.anti_alias_fir(q)
+    delay = (h.size - 1) // 2
+    t = np.arange((n_out - 1) * q + delay + 1) / (q * FS)
+    keep = slice(delay // q + 1, n_out - 1)
+    for f in (1.0, 30.0, 0.25 * FS, L.PASSBAND * FS):
+        out = L.daq(np.sin(2 * np.pi * f * t + 0.3), n_out)
+        expected = np.sin(2 * np.pi * f * t[:: q][:n_out] + 0.3)
+        assert np.max(np.abs(out - expected)[keep]) < 1e-4, f
+    for f in (L.STOPBAND * FS, 0.6 * FS, FS, 2.3 * FS, 3.9 * FS):
+        out = L.daq(np.sin(2 * np.pi * f * t), n_out)
+        assert np.max(np.abs(out[keep])) < 1e-3, f  # > 60 dB down
+
+
+def test_sensor_noise_has_its_rms():
+    noise = L.sensor_noise(np.random.default_rng(0), 0.05, 20000)
+    assert L._rms(noise) == pytest.approx(0.05, rel=0.03)
+
+
+# --------------------------------------------------------------------------- generation
+
+def test_effect_free_recording_is_the_baseline_plus_noise():
+    g = L.generate("none", 4, duration_s=6.0)
+    assert np.all(g.contribution == 0.0)
+    np.testing.assert_array_equal(g.clean_rel_acc, g.baseline_rel_acc)
+    noise = g.recording["rel_acc"].to_numpy() - g.clean_rel_acc
+    assert L._rms(noise[256:]) == pytest.approx(g.truth["noise_rms_rel_acc"], rel=1e-9)
+    assert g.truth["noise_rms_rel_acc"] == pytest.approx(NOISE, rel=0.1)
+    assert g.truth["ratio_achieved"] == 0.0 and g.truth["effect"]["strength"] is None
+
+
+@pytest.mark.parametrize("name,ratio", [("lugre", 0.5), ("end_stop_linear", 1.5),
+                                        ("payload_error", 0.5), ("karnopp", 0.8)])
+def test_calibration_reaches_the_ratio(name, ratio):
+    g = L.generate(name, 11, ratio=ratio, duration_s=8.0)
+    achieved = L._rms(g.contribution[256:]) / g.truth["noise_rms_rel_acc"]
+    assert achieved == pytest.approx(ratio, rel=0.01)
+    assert g.truth["ratio_achieved"] == pytest.approx(achieved, rel=1e-12)
+    assert 0.0 <= g.truth["unabsorbed_to_noise"] <= achieved + 1e-12
+    assert g.truth["peak_to_noise"] >= achieved
+    tol = L.KARNOPP_CONVERGENCE_TOL if name == "karnopp" else L.CONVERGENCE_TOL
+    assert g.truth["integration"]["step_halving_change_to_noise"] <= tol
+    np.testing.assert_allclose(g.clean_rel_acc - g.baseline_rel_acc, g.contribution)
+
+
+def test_same_seed_same_recording_other_seed_other_device():
+    a, b = (L.generate("stribeck_gaussian", 7, duration_s=6.0) for _ in range(2))
+    pd.testing.assert_frame_equal(a.recording, b.recording, check_exact=True)
+    assert json.dumps(a.truth) == json.dumps(b.truth)
+    c = L.generate("stribeck_gaussian", 8, duration_s=6.0)
+    assert c.truth["device"] != a.truth["device"]
+
+
+def _project_reader():
+    """The project's reader of converted recordings (moved between releases)."""
+    import importlib
+
+    for module in ("harvester.data.daq", "harvester.daq"):
+        try:
+            return importlib.import_module(module).read_recording
+        except ModuleNotFoundError:
+            continue
+    pytest.skip("the project's read_recording is not importable")
+
+
+def test_files_are_written_atomically_and_read_back(tmp_path, monkeypatch):
+    read_recording = _project_reader()
+    g = L.generate("duffing", 2, duration_s=6.0, lsb=1e-3)
+    paths = g.write(tmp_path)
+    df = read_recording(paths["recording"])
+    pd.testing.assert_frame_equal(df, pd.read_csv(paths["recording"]))
+    assert list(df.columns) == ["time", "base_acc", "rel_acc"]
+    np.testing.assert_allclose(df.to_numpy(), g.recording.to_numpy(), rtol=1e-9, atol=1e-12)
+    assert df["time"].iloc[0] == 0.0 and np.allclose(np.diff(df["time"]), 1 / FS)
+    steps = df["base_acc"].to_numpy() / 1e-3
+    assert np.allclose(steps, np.round(steps), atol=1e-6)  # quantised
+    assert yaml.safe_load(paths["sidecar"].read_text()) == g.sidecar
+    assert json.loads(paths["truth"].read_text())["scenario"] == "duffing"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["recording.csv", "recording.yaml",
+                                                          "truth.json"]
+    before = paths["truth"].read_text()
+
+    def fail(*args):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(L.os, "replace", fail)
+    g.truth["scenario"] = "changed"
+    with pytest.raises(OSError):
+        g.write(tmp_path)
+    assert paths["truth"].read_text() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["recording.csv", "recording.yaml",
+                                                          "truth.json"]
+
+
+def test_unknown_scenario_is_named():
+    with pytest.raises(ValueError, match="unknown scenario"):
+        L.generate("coulomb", 0)
+
+
+@pytest.mark.slow
+def test_every_scenario_generates_at_its_ratio():
+    for name in L.SCENARIOS:
+        g = L.generate(name, 21, duration_s=10.0)
+        target = 0.0 if name == "none" else 0.5
+        assert g.truth["ratio_achieved"] == pytest.approx(target, rel=0.01, abs=1e-12), name
+        assert g.truth["integration"]["step_halving_change_to_noise"] <= (
+            L.KARNOPP_CONVERGENCE_TOL if name == "karnopp" else L.CONVERGENCE_TOL), name
+        json.dumps(g.truth)
+
+
+@pytest.mark.slow
+def test_a_40_s_record_generates_in_seconds():
+    import time
+
+    start = time.perf_counter()
+    g = L.generate("lugre", 0)
+    assert len(g.recording) == 40 * 256
+    assert time.perf_counter() - start < 30.0
