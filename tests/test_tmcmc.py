@@ -220,13 +220,14 @@ def test_population_logp_calls_fn_once_per_batch():
 def test_sampling_calls_fn_once_per_move():
     counter = CountingLogLike()
     model = op_model(counter)
-    mcmc_steps, draws = 3, 300
-    idata = run_tmcmc(model, draws=draws, chains=2, seed=2, mcmc_steps=mcmc_steps)
-    stages = idata.sample_stats["n_stages"].values
-    assert len(counter.calls) == int(np.sum(1 + mcmc_steps * stages))
+    draws = 300
+    idata = run_tmcmc(model, draws=draws, chains=2, seed=2, mcmc_steps=2)
+    moves = idata.sample_stats["mcmc_steps"].values  # (chain, stage), adapted per stage
+    total_moves = int(np.nansum(moves))
+    assert len(counter.calls) == 2 + total_moves
     assert set(counter.calls) == {(draws, 2)}
     assert idata.sample_stats["n_evals_total"].values.tolist() == [
-        draws * (1 + mcmc_steps * s) for s in stages
+        int(draws * (1 + np.nansum(m))) for m in moves
     ]
 
 
@@ -471,3 +472,67 @@ def test_reference_needs_a_scalar_free_variable_of_the_model(linear_gaussian):
     model, _ = linear_gaussian
     with pytest.raises(ValueError, match="not in the model"):
         run_tmcmc(model, draws=50, chains=1, seed=0, reference=_reference())
+
+
+# --------------------------------------------------------------------------------------------
+# Adaptive moves and the stated precision of the evidence
+# --------------------------------------------------------------------------------------------
+
+
+def test_stage_variance_of_independent_particles_is_that_of_a_mean():
+    from harvester.inference.tmcmc import stage_log_variance
+    rng = np.random.default_rng(0)
+    log_w = rng.normal(0.0, 0.8, 4000)
+    w = np.exp(log_w)
+    expected = np.var(w) / (len(w) * np.mean(w) ** 2)
+    assert stage_log_variance(log_w, np.arange(len(w))) == pytest.approx(expected, rel=1e-3)
+
+
+def test_stage_variance_grows_when_copies_share_their_weights():
+    """Ten copies of each particle with one weight: the mean is no better than that of the
+    particles' one-tenth, so the variance is ten times that of independent ones."""
+    from harvester.inference.tmcmc import stage_log_variance
+    rng = np.random.default_rng(1)
+    base = rng.normal(0.0, 0.8, 400)
+    log_w = np.repeat(base, 10)
+    families = np.repeat(np.arange(400), 10)
+    independent = stage_log_variance(log_w, np.arange(log_w.size))
+    assert stage_log_variance(log_w, families) == pytest.approx(10 * independent, rel=0.05)
+
+
+def test_mixture_fit_finds_two_separated_components():
+    from harvester.inference.tmcmc import fit_gaussian_mixture
+    rng = np.random.default_rng(2)
+    x = np.vstack([rng.normal([-4.0, 0.0], 0.5, (300, 2)), rng.normal([4.0, 1.0], 1.0, (300, 2))])
+    mix = fit_gaussian_mixture(x, np.ones(len(x)), 3, rng)
+    assert len(mix.weights) == 2
+    order = np.argsort(mix.means[:, 0])
+    np.testing.assert_allclose(mix.means[order], [[-4.0, 0.0], [4.0, 1.0]], atol=0.2)
+    draws = mix.draw(rng, 20000)
+    assert np.mean(draws[:, 0] > 0) == pytest.approx(0.5, abs=0.03)
+    grid = np.linspace(-8, 9, 400)
+    xx, yy = np.meshgrid(grid, grid)
+    density = np.exp(mix.log_density(np.column_stack([xx.ravel(), yy.ravel()])))
+    assert density.sum() * (grid[1] - grid[0]) ** 2 == pytest.approx(1.0, abs=0.01)
+
+
+def test_correlation_of_a_population_with_itself_and_with_a_shuffle():
+    from harvester.inference.tmcmc import mean_abs_correlation
+    rng = np.random.default_rng(3)
+    x = rng.normal(size=(2000, 3))
+    assert mean_abs_correlation(x, x) == pytest.approx(1.0)
+    assert mean_abs_correlation(x, rng.permutation(x)) < 0.05
+
+
+def test_stated_evidence_errors_cover_the_spread_of_chains(linear_gaussian):
+    """Default (adaptive) settings, 16 chains of 400 particles: each chain's error against the
+    exact log evidence, over its stated standard error, spreads like a standard normal."""
+    model, exact = linear_gaussian
+    idata = run_tmcmc(model, draws=400, chains=16, seed=31)
+    err = log_evidence(idata) - exact
+    se = idata.sample_stats["log_evidence_se"].values
+    z = err / se
+    assert abs(err.mean()) < 3 * err.std() / np.sqrt(len(err)) + 0.05
+    assert 0.5 < np.sqrt(np.mean(z**2)) < 2.0, (err, se)
+    moves = idata.sample_stats["mcmc_steps"].values
+    assert np.nanmax(moves) <= 30 and np.nanmin(moves) >= 2

@@ -31,6 +31,8 @@ class TMCMCSettings:
     proposal_scale: float = 0.2
     target_cov: float = 1.0
     mcmc_steps: int = 2
+    max_mcmc_steps: int | None = 30
+    correlation_threshold: float = 0.1
     target_accept: float | None = None
 
     @classmethod
@@ -108,7 +110,9 @@ def identify(problem: Problem, priors: Mapping[str, PriorSpec],
              settings.chains, problem.n_data)
     idata = run_tmcmc(model, draws=settings.particles, chains=settings.chains, seed=settings.seed,
                       proposal_scale=settings.proposal_scale, target_cov=settings.target_cov,
-                      mcmc_steps=settings.mcmc_steps, target_accept=settings.target_accept,
+                      mcmc_steps=settings.mcmc_steps, max_mcmc_steps=settings.max_mcmc_steps,
+                      correlation_threshold=settings.correlation_threshold,
+                      target_accept=settings.target_accept,
                       reference=reference)
     idata.posterior.attrs["parameter_names"] = ",".join(problem.parameter_names)
     idata.posterior.attrs["model"] = problem.structure.name

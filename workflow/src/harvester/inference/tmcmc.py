@@ -21,9 +21,15 @@ One stage of `TMCMC` (the order in which PyMC's ``sample_smc`` calls the methods
     Proposal covariance = proposal_scale**2 * the weighted sample covariance of the stage's
     particles (weights of this stage, computed before resampling; Ching & Chen's beta = 0.2).
 ``mutate``
-    ``mcmc_steps`` random-walk Metropolis moves per particle, targeting f_{j+1}, in the model's
-    value-variable (unconstrained) space. Each move evaluates prior and likelihood of ALL N
-    proposals in one call of a compiled, vectorised function.
+    Metropolis moves of every particle, targeting f_{j+1}, in the model's value-variable
+    (unconstrained) space: random-walk moves (covariance proposal_scale^2 x the stage's) in
+    turn with independent moves proposed from a Gaussian mixture fitted to the stage, until
+    the population has forgotten where the resampling put it: at least ``mcmc_steps`` moves, then more until the mean over
+    dimensions of |corr(start, now)| across particles falls below ``correlation_threshold``,
+    at most ``max_mcmc_steps`` (PyMC's SMC kernels count their steps on the same correlation;
+    Betz, Papaioannou and Straub 2016 on why TMCMC's fixed chains leave the population
+    correlated). Each move evaluates prior and likelihood of ALL N proposals in one call of a
+    compiled, vectorised function.
 ``sample_stats``
     Per-stage statistics (``stats_dtypes_shapes``) and a progress line on the logger
     ``harvester.inference.tmcmc`` at INFO.
@@ -44,6 +50,15 @@ al. 2011): a model that nests another can start where the other's posterior lies
 posterior peak narrower than a few prior draws can hit (a resonance's frequency) can be found,
 without changing the prior, the posterior or the evidence.
 
+Precision of the evidence. Each stage's factor S_j = mean(w) is a mean over particles that
+are not independent: the resampling made copies (families) and the Metropolis moves only
+partly separate them. Its variance is estimated per stage as a cluster sample's, the
+families the clusters (``stage_log_variance``): var(log S_j) ~ F / (F - 1) sum_f
+(W_f - n_f mean(w))^2 / (N mean(w))^2, W_f the family's summed weight, n_f its size, F the
+number of families; the first stage's particles are independent prior draws. A chain's
+``log_evidence_se`` is the square root of the sum over stages; the benchmark
+(``benchmarks/bench_tmcmc.py``) compares it with the spread of independent chains.
+
 A NaN log-likelihood or log-prior is treated as -inf: such particles get zero weight and such
 proposals are rejected, so one failed simulation never stops a run. If every particle of a stage
 has zero likelihood the run stops with `TMCMCError`.
@@ -62,6 +77,7 @@ import logging
 import time
 import warnings
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 import arviz as az
 import numpy as np
@@ -90,9 +106,11 @@ __all__ = [
     "TMCMCError",
     "compile_population_logp",
     "log_evidence",
+    "mean_abs_correlation",
     "next_beta",
     "plausibility_log_weights",
     "run_tmcmc",
+    "stage_log_variance",
     "tidy_sample_stats",
     "weighted_covariance",
     "weights_cov",
@@ -101,6 +119,10 @@ __all__ = [
 logger = logging.getLogger("harvester.inference.tmcmc")
 
 RESAMPLING_SCHEMES = ("multinomial", "systematic")
+#: The independent proposals' covariances are the fitted mixture's widened by this factor.
+IMH_WIDEN = 1.2
+#: Independent proposals accepting less than this share are dropped for the rest of a stage.
+IMH_MIN_ACCEPT = 0.05
 
 
 class TMCMCError(RuntimeError):
@@ -156,6 +178,119 @@ def next_beta(
     # need a step of almost zero: that stage only removes them).
     new_beta = min(old_beta + high, 1.0)
     return new_beta, plausibility_log_weights(likelihood_logp, new_beta - old_beta)
+
+
+def stage_log_variance(log_weights: np.ndarray, families: np.ndarray) -> float:
+    """Variance of log mean(w) for weights of particles grouped in families (cluster sample).
+
+    var(mean w) = F / (F - 1) sum_f (W_f - n_f mean(w))^2 / N^2 with W_f the summed weight of
+    family f, n_f its size and F the number of families; var(log mean w) = var(mean w) /
+    mean(w)^2 (delta method). Independent particles are families of one.
+    """
+    top = np.max(log_weights)
+    if not np.isfinite(top):
+        return np.inf
+    w = np.exp(log_weights - top)
+    n = w.size
+    labels, index = np.unique(families, return_inverse=True)
+    n_families = labels.size
+    if n_families < 2:
+        return np.inf
+    totals = np.bincount(index, weights=w, minlength=n_families)
+    sizes = np.bincount(index, minlength=n_families)
+    mean = w.mean()
+    var = n_families / (n_families - 1.0) * np.sum((totals - sizes * mean) ** 2) / n**2
+    return float(var / mean**2)
+
+
+def mean_abs_correlation(start: np.ndarray, now: np.ndarray) -> float:
+    """Mean over dimensions of |Pearson correlation| between two populations' coordinates
+    (particles paired by row); dimensions that do not vary in either count as 0."""
+    a = start - start.mean(axis=0)
+    b = now - now.mean(axis=0)
+    norm = np.sqrt(np.sum(a * a, axis=0) * np.sum(b * b, axis=0))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rho = np.where(norm > 0, np.abs(np.sum(a * b, axis=0)) / norm, 0.0)
+    return float(np.mean(rho))
+
+
+@dataclass(frozen=True)
+class GaussianMixture:
+    """A mixture of Gaussians in the particles' (value-variable) space: weights (K,), means
+    (K, d), Cholesky factors of the covariances (K, d, d)."""
+
+    weights: np.ndarray
+    means: np.ndarray
+    chols: np.ndarray
+
+    def log_density(self, x: np.ndarray) -> np.ndarray:
+        """log of the mixture's density at each row of x."""
+        x = np.atleast_2d(x)
+        d = x.shape[1]
+        comps = []
+        for w, mu, chol in zip(self.weights, self.means, self.chols):
+            z = np.linalg.solve(chol, (x - mu).T)
+            logdet = 2.0 * np.sum(np.log(np.diag(chol)))
+            comps.append(np.log(w) - 0.5 * (np.sum(z * z, axis=0) + logdet
+                                            + d * np.log(2.0 * np.pi)))
+        return logsumexp(np.array(comps), axis=0)
+
+    def draw(self, rng: np.random.Generator, n: int) -> np.ndarray:
+        """n draws (rows)."""
+        k = rng.choice(len(self.weights), size=n, p=self.weights)
+        z = rng.standard_normal((n, self.means.shape[1]))
+        return self.means[k] + np.einsum("nij,nj->ni", self.chols[k], z)
+
+
+def fit_gaussian_mixture(x: np.ndarray, weights: np.ndarray, components: int,
+                         rng: np.random.Generator, iterations: int = 50,
+                         widen: float = 1.0) -> GaussianMixture:
+    """Weighted EM fit of a Gaussian mixture with up to ``components`` components to the
+    weighted particles, the number chosen by BIC (each component needs 5 d effective
+    particles); covariances multiplied by ``widen``^2 (a proposal with lighter tails than
+    its target would stick at the target's tail points)."""
+    w = weights / weights.sum()
+    n_eff = 1.0 / np.sum(w**2)
+    d = x.shape[1]
+    best, best_bic = None, np.inf
+    for k in range(1, components + 1):
+        if k > 1 and n_eff < 5 * d * k:
+            break
+        mix, loglike = _em(x, w, k, rng, iterations)
+        n_par = k * (d + d * (d + 1) / 2) + k - 1
+        bic = -2.0 * n_eff * loglike + n_par * np.log(n_eff)
+        if bic < best_bic:
+            best, best_bic = mix, bic
+    return GaussianMixture(best.weights, best.means, best.chols * widen)
+
+
+def _em(x: np.ndarray, w: np.ndarray, k: int, rng: np.random.Generator, iterations: int
+        ) -> tuple[GaussianMixture, float]:
+    """EM for a k-component mixture; returns it and the weighted mean log-likelihood."""
+    n, d = x.shape
+    scale = np.mean(np.diag(np.atleast_2d(np.cov(x.T, aweights=w))))
+    means = x[rng.choice(n, size=k, replace=False, p=w)]
+    covs = np.array([weighted_covariance(x, w) for _ in range(k)])
+    pis = np.full(k, 1.0 / k)
+    loglike = -np.inf
+    for _ in range(iterations):
+        chols = np.array([_cholesky_with_jitter(c + 1e-9 * scale * np.eye(d)) for c in covs])
+        comp = np.array([GaussianMixture(np.ones(1), means[j:j + 1], chols[j:j + 1])
+                         .log_density(x) + np.log(pis[j]) for j in range(k)])
+        total = logsumexp(comp, axis=0)
+        new = float(np.sum(w * total))
+        resp = np.exp(comp - total) * w  # (k, n)
+        mass = resp.sum(axis=1)
+        if np.any(mass < 1e-6):
+            break
+        pis, means = mass / mass.sum(), (resp @ x) / mass[:, None]
+        covs = np.array([weighted_covariance(x, resp[j]) for j in range(k)])
+        if new - loglike < 1e-6 * abs(new):
+            loglike = new
+            break
+        loglike = new
+    chols = np.array([_cholesky_with_jitter(c + 1e-9 * scale * np.eye(d)) for c in covs])
+    return GaussianMixture(pis, means, chols), loglike
 
 
 def weighted_covariance(particles: np.ndarray, weights: np.ndarray) -> np.ndarray:
@@ -298,7 +433,21 @@ class TMCMC(SMC_KERNEL):
         Coefficient of variation of the plausibility weights that sets each tempering step
         (Ching & Chen: 100 %). Smaller values give more, gentler stages.
     mcmc_steps : int, default 2
-        Metropolis moves per particle per stage.
+        Fewest Metropolis moves per particle per stage.
+    max_mcmc_steps : int or None, default 30
+        Most moves per stage; the moves go on until the population decorrelates
+        (``correlation_threshold``). None: exactly ``mcmc_steps`` (Ching & Chen's fixed
+        chains).
+    correlation_threshold : float, default 0.1
+        Stop moving once the mean over dimensions of |corr(start, now)| across particles is
+        below this.
+    independent_moves : bool, default True
+        Alternate random-walk moves with independent Metropolis-Hastings moves proposed from a
+        Gaussian mixture fitted (weighted EM, components by BIC) to the stage's particles,
+        covariances widened by IMH_WIDEN (PyMC's IMH kernel proposes from one Gaussian). False:
+        random-walk moves only, as Ching & Chen.
+    mixture_components : int, default 3
+        Most components of that mixture.
     target_accept : float or None, default None
         None keeps ``proposal_scale`` fixed (Ching & Chen). A value (e.g. 0.25) adapts the scale
         after every stage, scale <- scale * exp(2 (acceptance - target_accept)), as in Betz,
@@ -329,6 +478,13 @@ class TMCMC(SMC_KERNEL):
         "log_mean_weight": (float, []),
         # Achieved coefficient of variation and effective sample size of the weights.
         "weights_cov": (float, []),
+        # Variance of this stage's log S_j (families of the last resampling as clusters).
+        "log_weight_variance": (float, []),
+        # Metropolis moves made and the correlation with the start they left.
+        "mcmc_steps": (int, []),
+        "correlation": (float, []),
+        # Acceptance of the independent (mixture) proposals.
+        "imh_accept_rate": (float, []),
         "ess": (float, []),
         # Particle likelihood evaluations and wall time (s) in the stage; the first stage also
         # counts evaluating the initial (prior) population.
@@ -343,6 +499,10 @@ class TMCMC(SMC_KERNEL):
         proposal_scale: float = 0.2,
         target_cov: float = 1.0,
         mcmc_steps: int = 2,
+        max_mcmc_steps: int | None = 30,
+        correlation_threshold: float = 0.1,
+        independent_moves: bool = True,
+        mixture_components: int = 3,
         target_accept: float | None = None,
         resampling: str = "multinomial",
         reference: Reference | None = None,
@@ -355,6 +515,12 @@ class TMCMC(SMC_KERNEL):
             raise ValueError(f"target_cov must be positive, got {target_cov}")
         if int(mcmc_steps) < 1:
             raise ValueError(f"mcmc_steps must be at least 1, got {mcmc_steps}")
+        if max_mcmc_steps is not None and int(max_mcmc_steps) < int(mcmc_steps):
+            raise ValueError(f"max_mcmc_steps ({max_mcmc_steps}) must be at least mcmc_steps "
+                             f"({mcmc_steps})")
+        if not 0.0 < correlation_threshold < 1.0:
+            raise ValueError(f"correlation_threshold must be in (0, 1), got "
+                             f"{correlation_threshold}")
         if resampling not in RESAMPLING_SCHEMES:
             raise ValueError(f"resampling must be one of {RESAMPLING_SCHEMES}, got {resampling!r}")
         super().__init__(*args, **kwargs)
@@ -365,6 +531,11 @@ class TMCMC(SMC_KERNEL):
         self.target_accept = target_accept
         self.target_cov = float(target_cov)
         self.mcmc_steps = int(mcmc_steps)
+        self.max_mcmc_steps = int(mcmc_steps if max_mcmc_steps is None else max_mcmc_steps)
+        self.correlation_threshold = float(correlation_threshold)
+        self.independent_moves = bool(independent_moves)
+        self.mixture_components = int(mixture_components)
+        self.mixture: GaussianMixture | None = None
         self.resampling = resampling
         self.log = log
         model = modelcontext(kwargs.get("model"))
@@ -380,6 +551,11 @@ class TMCMC(SMC_KERNEL):
 
     def _reset_stage_state(self) -> None:
         self.log_mean_weight = np.nan
+        self.log_weight_variance = np.nan
+        self.steps_used = 0
+        self.correlation = np.nan
+        self.imh_acc_rate = np.nan
+        self.families = np.arange(self.draws)  # independent prior draws
         self.weights_cov = np.nan
         self.ess = np.nan
         self.acc_rate = np.nan
@@ -470,6 +646,7 @@ class TMCMC(SMC_KERNEL):
                                      self.target_cov)
         log_sum = logsumexp(log_w)
         self.log_mean_weight = float(log_sum - np.log(self.draws))
+        self.log_weight_variance = stage_log_variance(log_w, self.families)
         self.log_marginal_likelihood += self.log_mean_weight
         self.weights = np.exp(log_w - log_sum)
         self.weights /= self.weights.sum()
@@ -484,6 +661,7 @@ class TMCMC(SMC_KERNEL):
         else:
             self.resampling_indexes = systematic_resampling(self.weights, self.rng)
         self.tempered_posterior = self.tempered_posterior[self.resampling_indexes]
+        self.families = self.resampling_indexes.copy()
         self.prior_logp = self.prior_logp[self.resampling_indexes]
         self.likelihood_logp = self.likelihood_logp[self.resampling_indexes]
         self.reference_log_ratio = self.reference_log_ratio[self.resampling_indexes]
@@ -505,33 +683,87 @@ class TMCMC(SMC_KERNEL):
                 "covariance is not finite (a particle has an infinite coordinate)"
             )
         self.proposal_chol = _cholesky_with_jitter(cov)
+        self.mixture = None
+        if self.independent_moves:
+            self.mixture = fit_gaussian_mixture(self.stage_particles, self.weights,
+                                                self.mixture_components, self.rng,
+                                                widen=IMH_WIDEN)
+            self.mixture_logq = self.mixture.log_density(self.tempered_posterior)
 
     def mutate(self) -> None:
-        """``mcmc_steps`` Metropolis moves per particle, all particles evaluated at once."""
-        n, d = self.tempered_posterior.shape
-        accepted = 0
-        for _ in range(self.mcmc_steps):
-            step = self.rng.standard_normal((n, d)) @ self.proposal_chol.T
-            proposal = floatX(self.tempered_posterior + step)
-            prior_logp, likelihood_logp = self.evaluate(proposal)
-            ref_ratio = self._log_ratio(proposal)
-            with np.errstate(invalid="ignore"):
-                proposal_logp = self._tempered(prior_logp, likelihood_logp, ref_ratio)
-                proposal_logp[np.isnan(proposal_logp)] = -np.inf
-                log_ratio = proposal_logp - self.tempered_posterior_logp
-            log_u = np.log(self.rng.random(n))
-            accept = np.isfinite(proposal_logp) & (log_u < log_ratio)
-            self.tempered_posterior[accept] = proposal[accept]
-            self.prior_logp[accept] = prior_logp[accept]
-            self.likelihood_logp[accept] = likelihood_logp[accept]
-            self.reference_log_ratio[accept] = ref_ratio[accept]
-            self.tempered_posterior_logp[accept] = proposal_logp[accept]
-            accepted += int(accept.sum())
-        self.acc_rate = accepted / (n * self.mcmc_steps)
+        """Metropolis moves of all particles (one batched evaluation each) until the population
+        decorrelates from its start (``mcmc_steps`` .. ``max_mcmc_steps``): independent
+        proposals from a Gaussian mixture fitted to the stage (``independent_moves``) and
+        random-walk proposals in turn; the independent ones are dropped for the rest of the
+        stage when they accept under IMH_MIN_ACCEPT."""
+        n = self.tempered_posterior.shape[0]
+        start = self.tempered_posterior.copy()
+        accepted = steps = rw_steps = imh_accepted = imh_steps = 0
+        use_imh = self.mixture is not None
+        while steps < self.max_mcmc_steps:
+            if use_imh and steps % 2 == 0:
+                got = self._independent_move()
+                imh_accepted += got
+                imh_steps += 1
+                use_imh = got >= IMH_MIN_ACCEPT * n
+            else:
+                accepted += self._move()
+                rw_steps += 1
+            steps += 1
+            if steps >= self.mcmc_steps:
+                self.correlation = mean_abs_correlation(start, self.tempered_posterior)
+                if self.correlation < self.correlation_threshold:
+                    break
+        self.steps_used = steps
+        self.acc_rate = accepted / (n * rw_steps) if rw_steps else np.nan
+        self.imh_acc_rate = imh_accepted / (n * imh_steps) if imh_steps else np.nan
         self.scale_used = self.proposal_scale
-        if self.target_accept is not None:
+        if self.target_accept is not None and rw_steps:
             factor = np.exp(2.0 * (self.acc_rate - self.target_accept))
             self.proposal_scale = float(np.clip(self.proposal_scale * factor, 1e-3, 5.0))
+
+    def _independent_move(self) -> int:
+        """One independent Metropolis-Hastings move of every particle, proposed from the
+        stage's mixture; returns how many accepted."""
+        n = self.tempered_posterior.shape[0]
+        proposal = floatX(self.mixture.draw(self.rng, n))
+        logq = self.mixture.log_density(proposal)
+        prior_logp, likelihood_logp = self.evaluate(proposal)
+        ref_ratio = self._log_ratio(proposal)
+        with np.errstate(invalid="ignore"):
+            proposal_logp = self._tempered(prior_logp, likelihood_logp, ref_ratio)
+            proposal_logp[np.isnan(proposal_logp)] = -np.inf
+            log_ratio = (proposal_logp - self.tempered_posterior_logp) + (self.mixture_logq
+                                                                          - logq)
+        accept = np.isfinite(proposal_logp) & (np.log(self.rng.random(n)) < log_ratio)
+        self._take(accept, proposal, prior_logp, likelihood_logp, ref_ratio, proposal_logp)
+        self.mixture_logq[accept] = logq[accept]
+        return int(accept.sum())
+
+    def _take(self, accept, proposal, prior_logp, likelihood_logp, ref_ratio, proposal_logp):
+        """Replace the accepted particles and their densities by the proposal's."""
+        self.tempered_posterior[accept] = proposal[accept]
+        self.prior_logp[accept] = prior_logp[accept]
+        self.likelihood_logp[accept] = likelihood_logp[accept]
+        self.reference_log_ratio[accept] = ref_ratio[accept]
+        self.tempered_posterior_logp[accept] = proposal_logp[accept]
+
+    def _move(self) -> int:
+        """One random-walk Metropolis move of every particle; returns how many accepted."""
+        n, d = self.tempered_posterior.shape
+        step = self.rng.standard_normal((n, d)) @ self.proposal_chol.T
+        proposal = floatX(self.tempered_posterior + step)
+        prior_logp, likelihood_logp = self.evaluate(proposal)
+        ref_ratio = self._log_ratio(proposal)
+        with np.errstate(invalid="ignore"):
+            proposal_logp = self._tempered(prior_logp, likelihood_logp, ref_ratio)
+            proposal_logp[np.isnan(proposal_logp)] = -np.inf
+            log_ratio = proposal_logp - self.tempered_posterior_logp
+        accept = np.isfinite(proposal_logp) & (np.log(self.rng.random(n)) < log_ratio)
+        self._take(accept, proposal, prior_logp, likelihood_logp, ref_ratio, proposal_logp)
+        if self.mixture is not None:
+            self.mixture_logq[accept] = self.mixture.log_density(proposal[accept])
+        return int(accept.sum())
 
     def sample_stats(self) -> SMCStats:
         now = time.perf_counter()
@@ -541,6 +773,10 @@ class TMCMC(SMC_KERNEL):
             "accept_rate": self.acc_rate,
             "log_mean_weight": self.log_mean_weight,
             "weights_cov": self.weights_cov,
+            "log_weight_variance": self.log_weight_variance,
+            "mcmc_steps": self.steps_used,
+            "correlation": self.correlation,
+            "imh_accept_rate": self.imh_acc_rate,
             "ess": self.ess,
             "n_evals": self.n_evals,
             "wall_time": now - self._stage_clock,
@@ -551,7 +787,10 @@ class TMCMC(SMC_KERNEL):
         self._say(
             f"TMCMC chain {self.chain} stage {self.iteration}: beta={self.beta:.4g} "
             f"(cov(w)={self.weights_cov:.2f}, ESS={self.ess:.0f}/{self.draws}), "
-            f"accept={self.acc_rate:.2f} (scale {self.scale_used:.3g}), log_evidence={self.log_marginal_likelihood:.3f}, "
+            f"accept={self.acc_rate:.2f} (scale {self.scale_used:.3g}, independent "
+            f"{self.imh_acc_rate:.2f}), "
+            f"{self.steps_used} moves (corr {self.correlation:.2f}), "
+            f"log_evidence={self.log_marginal_likelihood:.3f}, "
             f"{stats['n_evals']} evals in {stats['wall_time']:.2f} s"
         )
         return stats
@@ -564,6 +803,8 @@ class TMCMC(SMC_KERNEL):
             "proposal_scale": self.initial_scale,
             "target_cov": self.target_cov,
             "mcmc_steps": self.mcmc_steps,
+            "max_mcmc_steps": self.max_mcmc_steps,
+            "correlation_threshold": self.correlation_threshold,
             "target_accept": -1.0 if self.target_accept is None else self.target_accept,
             "resampling": self.resampling,
         }
@@ -583,7 +824,8 @@ class TMCMC(SMC_KERNEL):
 
 #: Per-stage statistics copied into run_tmcmc's sample_stats, with dims (chain, stage).
 STAGE_STATS = ("beta", "accept_rate", "log_mean_weight", "weights_cov", "ess", "n_evals",
-               "wall_time", "proposal_scale")
+               "wall_time", "proposal_scale", "log_weight_variance", "mcmc_steps",
+               "correlation", "imh_accept_rate")
 
 
 def _per_chain_stage_lists(values, chains: int) -> list[np.ndarray]:
@@ -626,6 +868,9 @@ def tidy_sample_stats(sample_stats: xr.Dataset, chains: int, wall_time: float) -
     running = [np.cumsum(rows) for rows in raw["log_mean_weight"]]
     data["log_marginal_likelihood"] = (("chain", "stage"), _ragged_to_matrix(running))
     data["log_evidence"] = (("chain",), np.array([r[-1] for r in running]))
+    if "log_weight_variance" in raw:
+        data["log_evidence_se"] = (("chain",), np.array(
+            [float(np.sqrt(np.sum(v))) for v in raw["log_weight_variance"]]))
     data["n_stages"] = (("chain",), np.array([len(r) for r in running]))
     data["n_evals_total"] = (("chain",), np.array([np.sum(r) for r in raw["n_evals"]], dtype=int))
     data["wall_time_total"] = (("chain",), np.array([np.sum(r) for r in raw["wall_time"]]))
