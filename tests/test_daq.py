@@ -242,7 +242,8 @@ def test_recording_too_short(tmp_path) -> None:
 
 def test_recording_times_rounded_to_6_decimals_accepted(tmp_path) -> None:
     t = np.arange(200) / 256.0
-    lines = ["time,base_acc,rel_acc"] + [f"{x:.6f},0.0,0.0" for x in t]
+    lines = ["time,base_acc,rel_acc"] + [f"{x:.6f},{np.sin(9 * x):.6f},{np.cos(5 * x):.6f}"
+                                          for x in t]
     (tmp_path / "r.csv").write_text("\n".join(lines) + "\n")
     assert len(daq.read_recording(tmp_path / "r.csv")) == 200
 
@@ -329,7 +330,8 @@ def test_committed_raw_data_is_valid() -> None:
 
 def test_byte_order_mark_is_ignored(tmp_path) -> None:
     t = np.arange(64) / 256.0
-    lines = ["time,base_acc,rel_acc"] + [f"{x:.9f},0.0,0.0" for x in t]
+    lines = ["time,base_acc,rel_acc"] + [f"{x:.9f},{np.sin(9 * x):.6f},{np.cos(5 * x):.6f}"
+                                          for x in t]
     (tmp_path / "r.csv").write_text("\ufeff" + "\n".join(lines) + "\n", encoding="utf-8")
     assert list(daq.read_recording(tmp_path / "r.csv").columns) == list(daq.RECORDING_COLUMNS)
 

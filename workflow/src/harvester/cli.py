@@ -1,13 +1,19 @@
-"""Command line: ``harvester diagnose RECORDING.csv --baseline tanh --out DIR``.
+"""Command line: the whole method on one recording, each command a thin front on the library.
 
-RECORDING.csv has a header and the columns time (s, uniform), base_acc and rel_acc (m/s^2).
-An optional RECORDING.yaml beside it gives the known parameters ``M``, ``m``, ``k`` (default:
-the study's Table 1), and may give ``priors`` (``{name: {mean, sd}}``) and ``filtered_at_hz``
-(the cut-off of a zero-phase low-pass the recording already went through). The priors of
-c_m and F_c come from the recording's frequency response (``initial.recording_priors``: centred
-on its FRF fit when a static friction is given in ``priors``, else spanning the damping's split
-between the two), and beta's from the RMS velocity (smooth to sign-law friction). Progress
-goes to stderr, or to ``--log FILE``.
+    harvester check    REC                                 the instrument checks alone
+    harvester identify REC --model tanh+cubic_stiffness --out DIR
+    harvester compare  REC --models linear tanh --out DIR
+    harvester predict  REC --posterior DIR/posterior.nc --out DIR2
+    harvester diagnose REC --baseline tanh --out DIR
+    harvester terms                                        the physics library
+
+A recording is read and checked once (``harvester.data.daq.read_checked_recording``, the
+checks of ``harvester.data.checks``, the sidecar of ``harvester.data.sidecar``), ``--out`` is
+checked before any work, results appear in ``--out`` only when complete
+(``harvester.data.fileio.atomic_directory``: a killed run resumes from its staging
+directory), and every warning goes to the log and to the output (``run.json`` or
+``diagnosis.json``'s ``notes``). Exit status: 0 done, 2 bad input (the message names the
+file, the line or column, what was found and what was expected), 1 a bug (traceback).
 """
 
 from __future__ import annotations
@@ -15,24 +21,150 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+from dataclasses import asdict
 from pathlib import Path
 
 from harvester.data.errors import DataError
 
 log = logging.getLogger("harvester.cli")
 
+RECORDING_HELP = """\
+recording: a CSV file, comma-separated, '.' as the decimal point, with a header:
+  time      s       uniform steps
+  base_acc  m/s^2   input: base acceleration (gravity removed), or
+  force     N       input: force on the mass, base fixed
+  rel_acc   m/s^2   output: acceleration of the mass relative to the base, or
+  rel_disp  m       output: displacement of the mass relative to the base
+  (other columns are carried along unused).
+sidecar RECORDING.yaml beside it (optional): M (kg), m (kg), k (N/m), priors
+  ({name: {mean, sd}}), filtered_at_hz (Hz). Device parameters it does not give are
+  identified, or must be given, or assumed with --paper-device (the paper's Table 1:
+  M 12.8 kg, m 8 kg, k 250 N/m); what was assumed is logged and written to the output.
+exit status: 0 done, 2 bad input (named: file, line or column, found, expected)."""
+
+#: Sampler defaults of the command line (the study's config: 1000 particles x 4 chains).
+CLI_TMCMC = {"particles": 500, "chains": 2, "mcmc_steps": 3, "target_accept": 0.25}
+DIAGNOSE_KINDS = ("harvester diagnose", ("its detection, location and priors work on "
+                                         "accelerations only (harvester.diagnosis); identify, "
+                                         "compare and predict take force and rel_disp too"))
+DIAGNOSE_NEEDS = ("harvester diagnose (its priors of c_m and F_c come from the recording's "
+                  "FRF with M, m, k, and its candidates' priors scale with M and k)")
+
+_log_to_file = False
+
+
+# --------------------------------------------------------------------------- parser
+
+
+def _model_expression(text: str) -> str:
+    """argparse type: a model expression ``base+term+...`` the library can build."""
+    from harvester.model.structures import structure
+    try:
+        structure(text)
+    except (KeyError, ValueError) as err:
+        raise argparse.ArgumentTypeError(str(err.args[0] if err.args else err)) from None
+    return text
+
+
+def _command(sub, name: str, help_: str, example: str, outputs: str) -> argparse.ArgumentParser:
+    return sub.add_parser(name, help=help_, description=help_,
+                          formatter_class=argparse.RawDescriptionHelpFormatter,
+                          epilog=f"example:\n  {example}\n\n{outputs}\n\n{RECORDING_HELP}")
+
+
+def _recording_args(p: argparse.ArgumentParser, out: bool = True,
+                    paper_device: bool = True) -> None:
+    p.add_argument("recording", type=Path, help="the recording (CSV; see below)")
+    if out:
+        p.add_argument("--out", type=Path, required=True, metavar="DIR",
+                       help="output directory (created; replaced as a whole when the run "
+                            "completes; a killed run resumes)")
+    if paper_device:
+        p.add_argument("--paper-device", action="store_true",
+                       help="assume the paper's M, m, k (12.8 kg, 8 kg, 250 N/m) where the "
+                            "sidecar gives none (logged and written to the output)")
+    p.add_argument("--log", type=Path, metavar="FILE", help="progress to FILE, not stderr")
+
+
+def _fit_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--particles", type=int, default=CLI_TMCMC["particles"],
+                   help=f"TMCMC particles per chain ({CLI_TMCMC['particles']})")
+    p.add_argument("--chains", type=int, default=CLI_TMCMC["chains"],
+                   help=f"TMCMC chains ({CLI_TMCMC['chains']}; >= 2 for an evidence error)")
+    p.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    p.add_argument("--lead-in", type=float, default=1.0, metavar="S",
+                   help="seconds skipped before the likelihood (1.0; the model starts at rest)")
+    p.add_argument("--fit-seconds", type=float, metavar="S",
+                   help="most seconds fitted after the lead-in (default: all)")
+    p.add_argument("--filtered-at", type=float, metavar="HZ",
+                   help="the recording went through a zero-phase low-pass at HZ (default: the "
+                        "sidecar's filtered_at_hz, else found from its spectrum; 0: none)")
+    p.add_argument("--filter-order", type=int, default=8, help="order of that low-pass (8)")
+    p.add_argument("--no-figures", action="store_true", help="write no figures")
+
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="harvester",
-                                description="Bayesian identification tools for the harvester.")
-    sub = p.add_subparsers(dest="command", required=True)
-    d = sub.add_parser("diagnose", help="diagnose missing physics in one recording",
-                       description="Detect, locate and name physics missing from a baseline "
-                                   "model of a recording; writes DIR/diagnosis.json and figures.")
-    d.add_argument("recording", type=Path, help="CSV with time, base_acc, rel_acc")
-    d.add_argument("--baseline", choices=["linear", "tanh"], required=True,
-                   help="the model to diagnose (the paper's M1 or M2)")
-    d.add_argument("--out", type=Path, required=True, help="output directory")
+    p = argparse.ArgumentParser(prog="harvester", description=__doc__.split("\n")[0],
+                                formatter_class=argparse.RawDescriptionHelpFormatter,
+                                epilog=RECORDING_HELP)
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    c = _command(sub, "check", "check a recording as an instrument would, and nothing else",
+                 "harvester check rec.csv", "prints the recording's kinds, rate, duration, "
+                 "device parameters and every warning with its evidence")
+    _recording_args(c, out=False)
+    i = _command(sub, "identify", "identify one model structure by TMCMC",
+                 "harvester identify rec.csv --model tanh+cubic_stiffness --out fit",
+                 "writes DIR/posterior.nc, summary.csv (parameter, unit, mean, sd, 2.5 and 97.5 "
+                 "%), evidence.json (log evidence in nats per chain, pooled, standard error), "
+                 "posterior_pairs.png, run.json (known, assumed, priors, warnings)")
+    _recording_args(i)
+    i.add_argument("--model", type=_model_expression, required=True, metavar="EXPR",
+                   help="base+term+..., e.g. tanh+cubic_stiffness (harvester terms lists them)")
+    _fit_args(i)
+    c = _command(sub, "compare", "identify several structures; evidence and Bayes factors",
+                 "harvester compare rec.csv --models linear tanh --out cmp",
+                 "writes DIR/evidence.csv (model, log evidence and standard error in nats, log "
+                 "Bayes factor against the first model and its error), DIR/models/<model>/ "
+                 "as identify writes, run.json")
+    _recording_args(c)
+    c.add_argument("--models", type=_model_expression, nargs="+", required=True,
+                   metavar="EXPR", help="model expressions; Bayes factors against the first")
+    _fit_args(c)
+    _predict_parser(sub)
+    _diagnose_parser(sub)
+    _command(sub, "terms", "list the physics library: terms, equations, units, priors",
+             "harvester terms", "prints the base equation and every term")
+    return p
+
+
+def _predict_parser(sub) -> None:
+    d = _command(sub, "predict", "posterior predictive on an unseen recording",
+                 "harvester predict unseen.csv --posterior fit/posterior.nc --out pred",
+                 "writes DIR/predictive.csv (time s, measured, mean, lower_3sd, upper_3sd, "
+                 "sd_parameter, in the output's unit), validation.json (NRMSE, shares outside "
+                 "+-1, 2, 3 sd, mean log predictive density in nats), predictive.png, run.json."
+                 " The device's parameters are the posterior's.")
+    _recording_args(d, paper_device=False)
+    d.add_argument("--posterior", type=Path, required=True, metavar="P.nc",
+                   help="posterior.nc written by harvester identify (same device and kinds)")
+    d.add_argument("--samples", type=int, default=200, help="posterior samples simulated (200)")
+    d.add_argument("--seed", type=int, default=0, help="random seed of the thinning (0)")
+    d.add_argument("--lead-in", type=float, default=1.0, metavar="S",
+                   help="seconds left out of the metrics (1.0; the model starts at rest)")
+    d.add_argument("--no-figures", action="store_true", help="write no figure")
+
+
+def _diagnose_parser(sub) -> None:
+    d = _command(sub, "diagnose", "diagnose physics missing from a baseline model",
+                 "harvester diagnose rec.csv --baseline tanh --out diag",
+                 "writes DIR/diagnosis.json (verdict, missing effects, candidates' log "
+                 "evidence in nats, where the mismatch lies, the fit before and after; "
+                 "notes: warnings and assumptions) and figures. Needs base_acc and rel_acc, and "
+                 "M, m, k (sidecar or --paper-device).")
+    _recording_args(d)
+    d.add_argument("--baseline", type=_model_expression, required=True, metavar="EXPR",
+                   help="model to diagnose: any expression, e.g. linear, tanh, "
+                        "tanh+cubic_stiffness")
     d.add_argument("--validation", type=Path, help="unseen recording (same format) for the "
                    "before/after comparison; default: the recording's last quarter is held out")
     filt = d.add_mutually_exclusive_group()
@@ -40,113 +172,327 @@ def _parser() -> argparse.ArgumentParser:
                       help="use the recording as given (default); a low-pass it already went "
                            "through is found from its spectrum")
     filt.add_argument("--lowpass", type=float, metavar="HZ",
-                      help="low-pass both channels at HZ (zero-phase Butterworth) first")
+                      help="low-pass the output at HZ (zero-phase Butterworth) first")
     d.add_argument("--filtered-at", type=float, metavar="HZ",
                    help="the recording was already low-passed (zero-phase) at HZ")
     d.add_argument("--filter-order", type=int, default=8, help="order of that low-pass (8)")
-    d.add_argument("--seed", type=int, default=0)
+    d.add_argument("--seed", type=int, default=0, help="random seed (0)")
     d.add_argument("--particles", type=int, help="TMCMC particles per chain (300; fast: 150)")
     d.add_argument("--chains", type=int, default=2, help="TMCMC chains (2)")
     d.add_argument("--rounds", type=int, help="most effects added in turn (2; fast: 1)")
     d.add_argument("--top", type=int, help="candidates sampled per round (3; fast: 2)")
     d.add_argument("--fast", action="store_true", help="cheaper settings (for grids)")
     d.add_argument("--no-figures", action="store_true", help="write diagnosis.json only")
-    d.add_argument("--log", type=Path, metavar="FILE", help="progress to FILE, not stderr")
-    return p
 
 
-def _metadata(recording: Path) -> dict:
-    path = recording.with_suffix(".yaml")
-    if not path.exists():
-        return {}
-    import yaml
-    try:
-        meta = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as err:
-        raise DataError(path, f"invalid YAML: {err}") from None
-    if meta is None:
-        return {}
-    if not isinstance(meta, dict):
-        raise DataError(path, "expected a mapping with keys M, m, k (and optionally priors, "
-                              "filtered_at_hz)")
-    allowed = {"M", "m", "k", "priors", "filtered_at_hz"}
-    unknown = sorted(set(meta) - allowed)
-    if unknown:
-        raise DataError(path, f"unknown key(s) {unknown}; allowed: {sorted(allowed)}")
-    for key in ("M", "m", "k", "filtered_at_hz"):
-        if key in meta and (not isinstance(meta[key], (int, float)) or isinstance(meta[key], bool)
-                            or not meta[key] > 0):
-            raise DataError(path, f"'{key}' must be a positive number, got {meta[key]!r}")
-    priors = meta.get("priors", {})
-    if not isinstance(priors, dict):
-        raise DataError(path, "'priors' must map parameter names to {mean, sd}")
-    for name, spec in priors.items():
-        if not isinstance(spec, dict) or not {"mean", "sd"} <= set(spec) or \
-                not all(isinstance(spec[k], (int, float)) for k in ("mean", "sd")) or \
-                not spec["sd"] > 0:
-            raise DataError(path, f"priors.{name} must be {{mean: number, sd: positive number}}")
-    return meta
+# --------------------------------------------------------------------------- shared steps
 
 
-def diagnose_command(args: argparse.Namespace) -> int:
-    from harvester.data.daq import read_recording
-    from harvester.diagnosis import DiagnosisSettings, check_recording, diagnose
-    from harvester.initial.recording import recording_priors
+def _warn(text: str) -> None:
+    """A warning: to the log, and to the console once (the log is the console without --log)."""
+    log.warning("%s", text)
+    if _log_to_file:
+        print(f"harvester: warning: {text}", file=sys.stderr)
+
+
+def _read(path: Path, paper_device: bool, accept=None, known=None, known_from=None):
+    """(checked recording, known parameters); the checks' warnings reported."""
+    from harvester.data.daq import read_checked_recording
+    from harvester.data.sidecar import read_sidecar, resolve_known
     from harvester.study.paper import TABLE1_KNOWN
-    from harvester.data.signals import filter_recording, sampling_rate
+    sidecar = read_sidecar(path)
+    kp = resolve_known(sidecar, TABLE1_KNOWN if paper_device else None,
+                       "the paper's Table 1 (--paper-device)")
+    values = kp.values if known is None else known
+    checked = read_checked_recording(path, values, known_from or kp.source, accept=accept)
+    for w in checked.warnings:
+        _warn(str(w))
+    for note in kp.notes(sidecar):
+        (_warn if note.startswith("ASSUMED") else log.info)(note)
+    return checked, kp
 
-    logging.getLogger("pymc").setLevel(logging.ERROR)  # pymc sets INFO when imported
-    df = read_recording(args.recording)
-    meta = _metadata(args.recording)
-    known = {k: float(meta.get(k, v)) for k, v in TABLE1_KNOWN.items()}
-    lowpass = args.filtered_at or meta.get("filtered_at_hz")
-    if args.lowpass is not None:
-        fs = sampling_rate(df, str(args.recording))
-        if not 0 < args.lowpass < fs / 2:
-            raise DataError(args.recording, f"--lowpass {args.lowpass} Hz must lie in (0, "
-                                            f"{fs / 2:g}) Hz")
-        df = filter_recording(df, args.lowpass, args.filter_order, str(args.recording))
-        lowpass = args.lowpass
-    validation = None
-    if args.validation is not None:
-        validation = read_recording(args.validation)
-        if args.lowpass is not None:
-            validation = filter_recording(validation, args.lowpass, args.filter_order,
-                                          str(args.validation))
+
+def _lowpass(args: argparse.Namespace, checked) -> tuple[float | None, str]:
+    """The zero-phase low-pass the recording went through (Hz or None) and where it is from."""
+    from harvester.diagnosis.spectral import filter_cutoff
+    if args.filtered_at is not None:
+        return (args.filtered_at or None), "--filtered-at"
+    if checked.sidecar.filtered_at_hz is not None:
+        return checked.sidecar.filtered_at_hz, f"filtered_at_hz in {checked.sidecar.path}"
+    found = filter_cutoff(checked.data[checked.kinds.output_kind].to_numpy(), 1.0 / checked.dt)
+    return found, ("found from the output's spectrum (give --filtered-at to override)"
+                   if found else "none found in the output's spectrum")
+
+
+def _record(command: str, args: argparse.Namespace, checked, kp) -> dict:
+    """What run.json says about the input: recording, kinds, sidecar, known and assumed."""
+    from harvester.data.daq import sha256
+    df = checked.data
+    options = {k: (str(v) if isinstance(v, Path) else v) for k, v in vars(args).items()}
+    return {"command": command, "options": options, "recording": str(args.recording),
+            "recording_sha256": sha256(args.recording),
+            "input": checked.kinds.input_kind, "output": checked.kinds.output_kind,
+            "duration_s": float(len(df) * checked.dt), "sampling_rate_hz": 1.0 / checked.dt,
+            "sidecar": checked.sidecar.summary(), "known": kp.values,
+            "assumed": {"values": kp.assumed, "from": kp.assumed_from},
+            "warnings": [str(w) for w in checked.warnings],
+            "notes": kp.notes(checked.sidecar)}
+
+
+def _key(args: argparse.Namespace, *extra) -> str:
+    from harvester.data.fileio import run_key
+    from harvester.data.sidecar import sidecar_path
+    settings = {k: v for k, v in vars(args).items() if k not in ("out", "log", "models")}
+    return run_key(args.recording, sidecar_path(args.recording), settings, *extra)
+
+
+def _quiet_pymc() -> None:
+    """PyMC sets its logger to INFO when imported: quiet it once it is."""
+    import pymc  # noqa: F401
+    logging.getLogger("pymc").setLevel(logging.ERROR)
+
+
+def _settings(args: argparse.Namespace):
+    from harvester.inference.identify import TMCMCSettings
+    _quiet_pymc()
+    if args.particles < 20 or args.chains < 1:
+        raise DataError("<command line>", f"--particles {args.particles} and --chains "
+                        f"{args.chains}: need at least 20 particles and 1 chain")
+    return TMCMCSettings(particles=args.particles, chains=args.chains, seed=args.seed,
+                         mcmc_steps=CLI_TMCMC["mcmc_steps"],
+                         target_accept=CLI_TMCMC["target_accept"])
+
+
+# --------------------------------------------------------------------------- commands
+
+
+def check_command(args: argparse.Namespace) -> int:
+    checked, kp = _read(args.recording, args.paper_device)
+    df = checked.data
+    print(f"{args.recording}: {checked.kinds.input_kind} -> {checked.kinds.output_kind}, "
+          f"{len(df)} samples, {len(df) * checked.dt:.4g} s at {1.0 / checked.dt:.6g} Hz; "
+          f"{len(checked.warnings)} warning(s)")
+    for note in kp.notes(checked.sidecar):
+        print(f"  {note}")
+    for w in checked.warnings:
+        print(f"  warning: {w}")
+    return 0
+
+
+def _prepare_fit(args: argparse.Namespace, model: str, checked, kp):
+    """(problem, priors, notes) of one structure on the checked recording."""
+    from harvester.inference.recording_fit import FitWindow, recording_problem
+    from harvester.initial.recording import identification_priors
+    lowpass, where = _lowpass(args, checked)
+    window = FitWindow(args.lead_in, lowpass, args.filter_order, args.fit_seconds)
+    hint = f", in {checked.sidecar.path}, or pass --paper-device"
+    problem = recording_problem(checked.data, model, kp.values, window, str(args.recording),
+                                hint)
+    try:
+        priors, notes = identification_priors(
+            checked.data, problem.structure.free_parameters, problem.known,
+            checked.sidecar.priors, lowpass, str(args.recording))
+    except KeyError as err:  # a prior in the sidecar for a parameter the library lacks
+        raise DataError(checked.sidecar.path, str(err.args[0])) from None
+    notes = [f"output low-pass: {f'{lowpass:.3g} Hz' if lowpass else 'none'} ({where})",
+             f"{model}: identified {', '.join(problem.parameter_names)}; held "
+             + (", ".join(f"{k} = {v:g}" for k, v in problem.known.items()
+                          if not (k == "m" and problem.input_kind == "force")) or "none"),
+             *notes]
+    for note in notes:
+        log.info("%s", note)
+    return problem, priors, notes
+
+
+def _fit_record(problem, priors, notes, settings) -> dict:
+    return {"model": problem.structure.name, "identified": list(problem.parameter_names),
+            "held": problem.known, "window_s": [problem.window[0] * problem.dt,
+                                                problem.window[1] * problem.dt],
+            "output_filter": problem.output_filter, "settings": asdict(settings),
+            "priors": {n: asdict(s) for n, s in priors.items()
+                       if n in problem.parameter_names}, "prior_notes": notes}
+
+
+def identify_command(args: argparse.Namespace) -> int:
+    from harvester.data.fileio import atomic_directory, check_output_dir, write_json
+    from harvester.inference.recording_fit import fit_recording
+    check_output_dir(args.out, inputs=(args.recording,))
+    settings = _settings(args)
+    checked, kp = _read(args.recording, args.paper_device)
+    problem, priors, notes = _prepare_fit(args, args.model, checked, kp)
+    record = {**_record("identify", args, checked, kp),
+              **_fit_record(problem, priors, notes, settings)}
+    with atomic_directory(args.out, _key(args)) as stage:
+        fit = fit_recording(problem, priors, settings, stage, not args.no_figures,
+                            f"recording: {args.recording.name}")
+        write_json({**record, "evidence": fit.evidence}, stage / "run.json")
+    ev = fit.evidence
+    print(f"{args.model}: log evidence {ev['log_evidence']:.2f}"
+          + (f" +- {ev['standard_error']:.2f}" if ev["standard_error"] else "")
+          + f" -> {args.out}")
+    return 0
+
+
+def compare_command(args: argparse.Namespace) -> int:
+    import shutil
+
+    from harvester.data.fileio import atomic_directory, check_output_dir, write_json
+    from harvester.inference.compare import evidence_table, verdict
+    from harvester.inference.recording_fit import fit_recording
+    check_output_dir(args.out, inputs=(args.recording,))
+    if len(set(args.models)) != len(args.models):
+        raise DataError("<command line>", f"--models repeats a model: {args.models}")
+    settings = _settings(args)
+    checked, kp = _read(args.recording, args.paper_device)
+    prepared = {m: _prepare_fit(args, m, checked, kp) for m in args.models}
+    record = _record("compare", args, checked, kp)
+    with atomic_directory(args.out, _key(args)) as stage:
+        for old in (stage / "models").glob("*") if (stage / "models").exists() else []:
+            if old.name not in args.models:
+                shutil.rmtree(old)  # left by a killed run with other models
+        fits = {m: fit_recording(p, pr, settings, stage / "models" / m, not args.no_figures,
+                                 f"recording: {args.recording.name}")
+                for m, (p, pr, _) in prepared.items()}
+        table = evidence_table({m: f.evidence for m, f in fits.items()})
+        table.to_csv(stage / "evidence.csv", index=False, float_format="%.6g")
+        text = verdict(table)
+        write_json({**record, "verdict": text, "models": {
+            m: _fit_record(*prepared[m], settings) for m in args.models}}, stage / "run.json")
+    print(table.to_string(index=False, float_format=lambda x: f"{x:.2f}"))
+    print(f"{text} -> {args.out}")
+    return 0
+
+
+def predict_command(args: argparse.Namespace) -> int:
+    import arviz as az
+
+    from harvester.data.fileio import atomic_directory, check_output_dir, write_json
+    from harvester.inference.unseen import (posterior_structure, predict_unseen,
+                                            unseen_problem, write_prediction)
+    check_output_dir(args.out, inputs=(args.recording, args.posterior))
+    if not args.posterior.is_file():
+        raise DataError(args.posterior, "posterior not found (expected posterior.nc written by "
+                        "harvester identify)")
+    try:
+        idata = az.from_netcdf(args.posterior)
+    except (OSError, ValueError) as err:
+        raise DataError(args.posterior, f"cannot read as netCDF: {err}") from None
+    _quiet_pymc()
+    _, known = posterior_structure(idata, str(args.posterior))
+    checked, kp = _read(args.recording, False, known=known,
+                        known_from=f"the posterior {args.posterior.name}")
+    for name, value in kp.given.items():
+        if name in known and abs(known[name] - value) > 1e-9 * abs(value):
+            _warn(f"{checked.sidecar.path}: {name} = {value:g}, but the posterior holds "
+                  f"{name} = {known[name]:g}: a different device? The posterior's is used")
+    problem = unseen_problem(idata, checked.data, str(args.posterior), str(args.recording))
+    record = {**_record("predict", args, checked, kp), "posterior": str(args.posterior),
+              "model": problem.structure.name, "known": problem.known}
+    with atomic_directory(args.out, _key(args, Path(args.posterior))) as stage:
+        pred = predict_unseen(problem, idata, args.samples, args.seed, args.lead_in)
+        files = write_prediction(pred, stage, not args.no_figures,
+                                 f"recording: {args.recording.name}")
+        write_json({**record, "metrics": pred.metrics, "files": files}, stage / "run.json")
+    m = pred.metrics
+    print(f"{m['model']} on {args.recording.name}: NRMSE {m['nrmse']:.3f}, outside +-3 sd "
+          f"{m['outside_3sd']:.1%} (nominal {m['nominal_outside_3sd']:.1%}) -> {args.out}")
+    return 0
+
+
+def _diagnosis_settings(args: argparse.Namespace, lowpass: float | None):
+    from harvester.diagnosis import DiagnosisSettings
+    _quiet_pymc()
     overrides = {k: v for k, v in {"particles": args.particles, "rounds": args.rounds,
                                    "top": args.top}.items() if v is not None}
     overrides.update(chains=args.chains, seed=args.seed, lowpass_hz=lowpass,
                      filter_order=args.filter_order, figures=not args.no_figures)
-    settings = DiagnosisSettings.fast(**overrides) if args.fast else \
-        DiagnosisSettings(**overrides)
+    return DiagnosisSettings.fast(**overrides) if args.fast else DiagnosisSettings(**overrides)
+
+
+def _diagnosis_inputs(args: argparse.Namespace):
+    """(recording, validation, lowpass, known, sidecar priors, warnings and notes)."""
+    from harvester.data.recording import Accepted
+    from harvester.data.signals import filter_recording
+    accept = Accepted(("base_acc",), ("rel_acc",), *DIAGNOSE_KINDS)
+    checked, kp = _read(args.recording, args.paper_device, accept)
+    kp.require(("M", "m", "k"), DIAGNOSE_NEEDS, checked.sidecar)
+    df, lowpass = checked.data, args.filtered_at or checked.sidecar.filtered_at_hz
+    notes = [str(w) for w in checked.warnings] + kp.notes(checked.sidecar)
+    validation = None
+    if args.validation is not None:
+        vc, _ = _read(args.validation, args.paper_device, accept, kp.values, kp.source)
+        validation = vc.data
+        notes += [str(w) for w in vc.warnings]
+    if args.lowpass is not None:
+        if not 0 < args.lowpass < 0.5 / checked.dt:
+            raise DataError(args.recording, f"--lowpass {args.lowpass} Hz must lie in (0, "
+                            f"{0.5 / checked.dt:g}) Hz")
+        df = filter_recording(df, args.lowpass, args.filter_order, str(args.recording))
+        if validation is not None:
+            validation = filter_recording(validation, args.lowpass, args.filter_order,
+                                          str(args.validation))
+        lowpass = args.lowpass
+    return df, validation, lowpass, kp.values, checked.sidecar, notes
+
+
+def diagnose_command(args: argparse.Namespace) -> int:
+    from harvester.data.fileio import atomic_directory, check_output_dir
+    from harvester.diagnosis import check_recording, diagnose, write
+    from harvester.initial.recording import recording_priors
+
+    check_output_dir(args.out, inputs=tuple(p for p in (args.recording, args.validation) if p))
+    df, validation, lowpass, known, sidecar, notes = _diagnosis_inputs(args)
+    settings = _diagnosis_settings(args, lowpass)
     check_recording(df, str(args.recording), settings.lead_in_s,
                     0.0 if validation is not None else settings.holdout_fraction)
     try:
-        priors = recording_priors(df, known, meta.get("priors", {}), str(args.recording))
+        priors = recording_priors(df, known, sidecar.priors, str(args.recording))
     except KeyError as err:  # a prior in the sidecar for a parameter the library lacks
-        raise DataError(args.recording.with_suffix(".yaml"), str(err.args[0])) from None
-    diag = diagnose(df, args.baseline, known, priors, validation=validation,
-                    settings=settings, out_dir=args.out, source=str(args.recording))
+        raise DataError(sidecar.path, str(err.args[0])) from None
+    key = _key(args, Path(args.validation) if args.validation else None)
+    with atomic_directory(args.out, key) as stage:
+        diag = diagnose(df, args.baseline, known, priors, validation=validation,
+                        settings=settings, source=str(args.recording))
+        diag.notes[:0] = notes
+        write(diag, stage)
     print(f"{diag.verdict}" + (f": {', '.join(diag.missing)}" if diag.missing else "")
           + f" -> {args.out / 'diagnosis.json'}")
     return 0
 
 
+def terms_command(args: argparse.Namespace) -> int:
+    from harvester.model.terms import TERMS
+    from harvester.terms_table import terms_text
+    print(terms_text(TERMS))
+    return 0
+
+
+COMMANDS = {"check": check_command, "identify": identify_command, "compare": compare_command,
+            "predict": predict_command, "diagnose": diagnose_command, "terms": terms_command}
+
+
 def main(argv: list[str] | None = None) -> int:
+    global _log_to_file
     args = _parser().parse_args(argv)
     from harvester.runlog import setup
-    setup(args.log)
+    log_file, out = getattr(args, "log", None), getattr(args, "out", None)
+    if log_file and out and Path(out).resolve() in Path(log_file).resolve().parents:
+        print(f"harvester: error: {log_file}: --log lies inside --out {out}, which the results "
+              "replace as a whole: put the log beside it", file=sys.stderr)
+        return 2
+    _log_to_file = log_file is not None
+    setup(log_file)
     try:
-        if args.command == "diagnose":
-            return diagnose_command(args)
+        return COMMANDS[args.command](args)
     except DataError as err:
-        log.error("%s", err)
+        if _log_to_file:
+            log.error("%s", err)
         print(f"harvester: error: {err}", file=sys.stderr)
         return 2
     except Exception:
-        log.exception("diagnosis failed")
+        if _log_to_file:  # without --log the traceback below is the log's
+            log.exception("%s failed", args.command)
         raise
-    return 1
 
 
 if __name__ == "__main__":

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import math
+import re
 import sys
 import time
 from collections.abc import Iterator
@@ -25,9 +27,57 @@ def setup(log_file: str | Path | None = None, level: int = logging.INFO) -> logg
         handler = logging.FileHandler(log_file, mode="w")
     handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(levelname)s %(message)s",
                                            "%H:%M:%S"))
+    handler.addFilter(TimeLeft())
     root.addHandler(handler)
     root.propagate = False
     return root
+
+
+class TimeLeft(logging.Filter):
+    """Adds an estimate of the time left to the TMCMC progress lines.
+
+    Reads the lines ``inference.identify`` and the TMCMC kernel log (a run's chain count, each
+    chain's start, each stage's tempering exponent beta) and appends to each stage's line the
+    time left of the run: a chain's progress is taken as log(beta / beta_1) / log(1 / beta_1),
+    beta_1 its first stage's exponent (stages step about evenly in log beta), and the chains
+    still to come as long as this one. Other lines pass unchanged.
+    """
+
+    RUN = re.compile(r"TMCMC for (\S+): .* x (\d+) chains")
+    CHAIN = re.compile(r"TMCMC chain \d+: \d+ particles")
+    STAGE = re.compile(r"TMCMC chain \d+ stage (\d+): beta=([0-9.eE+-]+)")
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.chains, self.chain, self.started, self.beta_1 = 1, -1, None, None
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        message = record.getMessage()
+        if (run := self.RUN.search(message)) is not None:
+            self.chains, self.chain = int(run[2]), -1
+        elif self.CHAIN.match(message):
+            self.chain, self.started, self.beta_1 = self.chain + 1, record.created, None
+        elif (stage := self.STAGE.match(message)) is not None and self.started is not None:
+            left = self._left(float(stage[2]), record.created - self.started)
+            if left is not None:
+                record.msg, record.args = f"{message}; {left}", ()
+        return True
+
+    def _left(self, beta: float, elapsed: float) -> str | None:
+        if self.beta_1 is None:
+            self.beta_1 = beta
+            return None
+        if not 0.0 < self.beta_1 < 1.0:
+            return None
+        done = min(1.0, math.log(beta / self.beta_1) / math.log(1.0 / self.beta_1))
+        if done <= 0.0:
+            return None
+        chain_total = elapsed / done
+        later = max(self.chains - self.chain - 1, 0)
+        left = chain_total - elapsed + later * chain_total
+        where = f"chain {self.chain + 1} of {self.chains}"
+        return f"{where}, about {left:.0f} s left" if done < 1.0 or later else \
+            f"{where} done"
 
 
 @contextlib.contextmanager

@@ -8,6 +8,11 @@ Raw record (a DAQ export; ours are SIMULATED by ``harvester.synthetic.rig``):
   (``base_acceleration`` or ``mass_acceleration``), ``unit`` ``V``,
   ``sensitivity_mV_per_g``, ``zero_g_V``, ``range_g``, ``gravity_g``), ``seed``,
   ``generated_by``.
+* Loaded records (``harvester.synthetic.electrical``, :func:`loaded_record_metadata`) add a
+  third channel ``ai2``, quantity ``load_voltage``: the voltage between generator terminals a
+  and b through a voltage sensor (``gain_V_per_V``, ``zero_V``, ``range_V`` in load volts,
+  ``between``), and a ``load`` block (``resistance_ohm`` per resistor of the star, null in open
+  circuit) and a ``generator`` block (nameplate data; the constants to identify are withheld).
 
 Static friction test (eqs. 4-5): ``static_friction.csv`` with ``repeat,direction,position_m``
 (direction ``down`` or ``up``; positions downward-positive, m) and ``static_friction.json``.
@@ -16,7 +21,7 @@ Converted recording (also the input of ``harvester diagnose``): CSV with ``time`
 one input column, ``base_acc`` (y'', m/s^2) or ``force`` (N), and one output column,
 ``rel_acc`` (z'' = x'' - y'', eq. 1, m/s^2) or ``rel_disp`` (z, m), plus optional extra numeric
 columns. The column names declare the kinds (``harvester.data.recording``); the virtual rig's
-recordings are ``time, base_acc, rel_acc``.
+recordings are ``time, base_acc, rel_acc``, with ``voltage`` (V) from a loaded record.
 
 Every reader raises :class:`~harvester.data.errors.DataError` naming the file, the 1-based line
 (the header is line 1) and the column. Every writer is atomic (temporary file + rename).
@@ -28,18 +33,25 @@ import csv
 import hashlib
 import io
 import json
+import logging
 import math
 from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
+from harvester.data.checks import CheckWarning, check_recording
 from harvester.data.errors import DataError
 from harvester.data.fileio import atomic_path
-from harvester.data.recording import check_plausible, recording_kinds
+from harvester.data.recording import (INPUT_KINDS, OUTPUT_KINDS, UNITS, Accepted, RecordingKinds,
+                                      check_annotations, recording_kinds)
+from harvester.data.sidecar import Sidecar, read_sidecar
 from harvester.data.signals import time_base
+
+log = logging.getLogger("harvester.data")
 
 #: Standard gravity (m/s^2) used to convert g to m/s^2.
 G = 9.80665
@@ -58,6 +70,12 @@ SOURCE = ("virtual rig (harvester.synthetic.rig): SIMULATED recording, not data 
 GENERATED_BY = "workflow/scripts/make_raw_data.py (harvester.synthetic.rig, harvester.data.daq)"
 _CHANNEL_KEYS = ("name", "quantity", "unit", "sensitivity_mV_per_g", "zero_g_V", "range_g",
                  "gravity_g")
+#: The voltage channel of a loaded record, its quantity and its keys.
+VOLTAGE_CHANNEL = "ai2"
+VOLTAGE_QUANTITY = "load_voltage"
+_VOLTAGE_KEYS = ("name", "quantity", "unit", "gain_V_per_V", "zero_V", "range_V")
+GENERATED_BY_LOADED = ("workflow/scripts/make_raw_data.py (harvester.synthetic.electrical, "
+                       "harvester.synthetic.rig, harvester.data.daq)")
 
 
 # --------------------------------------------------------------------------- writing
@@ -94,9 +112,46 @@ def record_metadata(rig: Mapping[str, Any], record: str, n_samples: int,
             "channels": channels, "seed": int(seed), "generated_by": GENERATED_BY}
 
 
+def loaded_record_metadata(rig: Mapping[str, Any], record: str, n_samples: int, seed: int,
+                           load_ohm: float | None) -> dict[str, Any]:
+    """Metadata of a simulated loaded record: :func:`record_metadata` plus the voltage channel
+    ``ai2``, the load (``None``: open circuit) and the generator's nameplate data.
+
+    The generator's constants (K_e, R_s, L_s) are not recorded: they are what a loaded record
+    identifies, and they are ASSUMED values of the virtual rig (``rig.generator`` in the
+    config), the cited device descriptions giving none that could be retrieved.
+    """
+    gen = rig["generator"]
+    sensor = gen["voltage_sensor"]
+    meta = record_metadata(rig, record, n_samples, seed)
+    meta["source"] = SOURCE.replace("harvester.synthetic.rig",
+                                    "harvester.synthetic.rig + harvester.synthetic.electrical")
+    meta["channels"].append({
+        "name": VOLTAGE_CHANNEL, "quantity": VOLTAGE_QUANTITY, "unit": "V",
+        "gain_V_per_V": float(sensor["gain_V_per_V"]), "zero_V": float(sensor["zero_V"]),
+        "range_V": float(sensor["range_V"]),
+        "between": "generator terminals a and b (line-to-line): across the two star-connected "
+                   "load resistors of phases a and b in series; load voltage = "
+                   "(V - zero_V) / gain_V_per_V"})
+    meta["load"] = {
+        "connection": "three equal resistors in star on the generator terminals "
+                      "(Green et al. 2015, Figure 2)",
+        "resistance_ohm": None if load_ohm is None else float(load_ohm),
+        "open_circuit": load_ohm is None}
+    meta["generator"] = {
+        "type": "three-phase brushless permanent-magnet generator driven by the ball screw",
+        "lead_m": float(gen["lead_m"]), "pole_pairs": int(gen["pole_pairs"]),
+        "constants": "ASSUMED values of the virtual rig (the paper and the device "
+                     "descriptions it cites gave none that could be retrieved); K_e, R_s, L_s "
+                     "are withheld here as the quantities to identify"}
+    meta["generated_by"] = GENERATED_BY_LOADED
+    return meta
+
+
 def write_raw_record(df: pd.DataFrame, csv_path: str | Path, json_path: str | Path,
                      meta: Mapping[str, Any]) -> None:
-    """Write columns time (s, %.8f), ai0, ai1 (V, %.6f) and the metadata; byte-reproducible."""
+    """Write columns time (s, %.8f), the channels (ai0, ai1[, ai2]; V, %.6f) and the metadata;
+    byte-reproducible."""
     cols = ["time", *(c["name"] for c in meta["channels"])]
     _write_text(Path(csv_path), _csv_text(df[cols], ["%.8f"] + ["%.6f"] * (len(cols) - 1)))
     _write_json(Path(json_path), meta)
@@ -159,13 +214,51 @@ def _read_text(path: Path) -> str:
         raise DataError(path, f"cannot read: {err.strerror}") from None
 
 
+#: Separators other than the format's comma that exports use, by name.
+_OTHER_SEPARATORS = {";": "semicolons", "\t": "tabs", "|": "bars"}
+
+
+def _shown(line: str, width: int = 60) -> str:
+    """A line as read, quoted and cut to ``width`` characters."""
+    return repr(line if len(line) <= width else line[:width] + "...")
+
+
+def _separator_hint(first_line: str) -> str:
+    """What a header that did not split on commas seems to be separated by ('' if nothing)."""
+    for sep, name in _OTHER_SEPARATORS.items():
+        if first_line.count(sep) >= 1 and "," not in first_line:
+            return (f"the header {_shown(first_line)} was read as one column; it seems "
+                    f"separated by {name} ({sep!r}): the format needs commas, with '.' as the "
+                    "decimal point")
+    return ""
+
+
+def _ragged_row(path: Path, cells: list[str], header: list[str], line: int,
+                text: str) -> DataError:
+    """The error for a row whose field count differs from the header's, showing the row."""
+    raw = text.splitlines()[line - 1] if line - 1 < len(text.splitlines()) else ",".join(cells)
+    what = f"{len(cells)} fields, the header has {len(header)}: the row reads {_shown(raw)}"
+    if len(cells) > len(header) and all(c.strip().lstrip("-").isdigit() for c in cells[1:]):
+        what += ("; decimal commas? The format needs '.' as the decimal point and ',' "
+                 "between fields")
+    return DataError(path, what, line=line)
+
+
 def _read_rows(path: Path) -> tuple[list[str], list[list[str]], list[int]]:
-    """Header, data rows and their 1-based line numbers; rejects empty and ragged rows."""
+    """Header, data rows and their 1-based line numbers; rejects empty and ragged rows.
+
+    A header that is one field holding ';' or tabs is reported as another separator, and a
+    row with more fields than the header, all integers, as decimal commas; both errors show
+    the line as read.
+    """
     text = _read_text(path)
     reader = csv.reader(io.StringIO(text))
     header = [h.strip() for h in next(reader, [])]
     if not any(header):
-        raise DataError(path, "no header row", line=1)
+        raise DataError(path, "no header row (an empty file?)", line=1)
+    hint = _separator_hint(text.splitlines()[0]) if len(header) == 1 else ""
+    if hint:
+        raise DataError(path, hint, line=1)
     for j, name in enumerate(header):
         if not name or name in header[:j]:
             raise DataError(path, "empty or repeated column name in the header", line=1,
@@ -182,8 +275,7 @@ def _read_rows(path: Path) -> tuple[list[str], list[list[str]], list[int]]:
         if not any(c.strip() for c in cells):
             raise DataError(path, "empty row", line=reader.line_num)
         if len(cells) != len(header):
-            raise DataError(path, f"{len(cells)} fields, the header has {len(header)}",
-                            line=reader.line_num)
+            raise _ragged_row(path, cells, header, reader.line_num, text)
         rows.append(cells)
         lines.append(reader.line_num)
     return header, rows, lines
@@ -198,7 +290,8 @@ def _to_float(path: Path, cell: str, line: int, column: str) -> float:
     except ValueError:
         raise DataError(path, f"not a number: {cell!r}", line=line, column=column) from None
     if not math.isfinite(value):
-        raise DataError(path, f"{text} value (NaN or infinite)", line=line, column=column)
+        raise DataError(path, f"{text} value (NaN or infinite); expected a finite number",
+                        line=line, column=column)
     return value
 
 
@@ -277,26 +370,32 @@ def _check_raw_meta(path: Path, meta: Mapping[str, Any]) -> None:
     for i, ch in enumerate(channels):
         if not isinstance(ch, dict):
             raise DataError(path, f"channels[{i}] is not an object")
-        for key in _CHANNEL_KEYS:
+        voltage = ch.get("quantity") == VOLTAGE_QUANTITY
+        for key in _VOLTAGE_KEYS if voltage else _CHANNEL_KEYS:
             _require(path, ch, key, str if key in ("name", "quantity", "unit") else (int, float),
                      f"channels[{i}].")
         if ch["unit"] != "V":
             raise DataError(path, f"channels[{i}].unit must be 'V', got {ch['unit']!r}")
-        if ch["sensitivity_mV_per_g"] <= 0 or ch["range_g"] <= 0:
+        if voltage and (ch["gain_V_per_V"] <= 0 or ch["range_V"] <= 0):
+            raise DataError(path, f"channels[{i}]: gain and range must be positive")
+        if not voltage and (ch["sensitivity_mV_per_g"] <= 0 or ch["range_g"] <= 0):
             raise DataError(path, f"channels[{i}]: sensitivity and range must be positive")
 
 
 def clip_limits(meta: Mapping[str, Any], channel: Mapping[str, Any]) -> tuple[float, float]:
     """Lowest and highest voltage (V) a channel can report before it clips.
 
-    The tighter of the sensor's output swing (zero_g_V +- sensitivity x range_g) and the ADC
-    span (its first and last code).
+    The tighter of the sensor's output swing (zero_g_V +- sensitivity x range_g; for a voltage
+    channel zero_V +- gain_V_per_V x range_V) and the ADC span (its first and last code).
     """
-    sens = channel["sensitivity_mV_per_g"] / 1000.0
     lo, hi = meta["adc"]["range_V"]
     lsb = (hi - lo) / 2 ** meta["adc"]["bits"]
-    swing = sens * channel["range_g"]
-    return max(channel["zero_g_V"] - swing, lo), min(channel["zero_g_V"] + swing, hi - lsb)
+    if channel["quantity"] == VOLTAGE_QUANTITY:
+        zero, swing = channel["zero_V"], channel["gain_V_per_V"] * channel["range_V"]
+    else:
+        zero = channel["zero_g_V"]
+        swing = channel["sensitivity_mV_per_g"] / 1000.0 * channel["range_g"]
+    return max(zero - swing, lo), min(zero + swing, hi - lsb)
 
 
 def _check_clipping(path: Path, df: pd.DataFrame, meta: Mapping[str, Any],
@@ -353,11 +452,16 @@ def read_raw_record(csv_path: str | Path,
 def to_accelerations(df: pd.DataFrame, meta: Mapping[str, Any]) -> pd.DataFrame:
     """Volts to m/s^2: a = g (V - zero_g_V) / (sensitivity / 1000) - gravity_g g.
 
-    Returns time, base_acc (y''), mass_acc (x'') and rel_acc = mass_acc - base_acc (z'').
+    Returns time, base_acc (y''), mass_acc (x'') and rel_acc = mass_acc - base_acc (z''),
+    and from a loaded record's voltage channel ``voltage`` = (V - zero_V) / gain_V_per_V, the
+    load voltage in volts (an extra column).
     """
     out = {"time": df["time"].to_numpy(dtype=float)}
     for ch in meta["channels"]:
         v = df[ch["name"]].to_numpy(dtype=float)
+        if ch["quantity"] == VOLTAGE_QUANTITY:
+            out["voltage"] = (v - ch["zero_V"]) / ch["gain_V_per_V"]
+            continue
         acc = G * (v - ch["zero_g_V"]) / (ch["sensitivity_mV_per_g"] / 1000.0) \
             - ch["gravity_g"] * G
         out[{"base_acceleration": "base_acc", "mass_acceleration": "mass_acc"}[ch["quantity"]]] \
@@ -367,31 +471,88 @@ def to_accelerations(df: pd.DataFrame, meta: Mapping[str, Any]) -> pd.DataFrame:
                         "needs one base_acceleration and one mass_acceleration channel")
     frame = pd.DataFrame(out, columns=["time", "base_acc", "mass_acc"])
     frame["rel_acc"] = frame["mass_acc"] - frame["base_acc"]
+    if "voltage" in out:
+        frame["voltage"] = out["voltage"]
     return frame
 
 
-def read_recording(path: str | Path) -> pd.DataFrame:
-    """Read a converted recording: time (s), one input and one output column, extras allowed.
+@dataclass(frozen=True)
+class CheckedRecording:
+    """A converted recording as read and checked: its table, kinds, time step (s), the
+    sidecar beside it, and the checks' warnings (``harvester.data.checks``)."""
 
-    Input ``base_acc`` (m/s^2) or ``force`` (N); output ``rel_acc`` (m/s^2) or ``rel_disp`` (m)
-    (``harvester.data.recording.recording_kinds`` tells which from the columns). Every column must
-    be numeric with no NaN or empty rows, the time base uniform (``signals.time_base``),
-    there must be at least 64 samples, and a column in another unit (a header ``rel_disp_mm``,
-    an acceleration with gravity left in, a displacement in mm) is reported
-    (``harvester.data.recording.check_plausible``).
+    data: pd.DataFrame
+    kinds: RecordingKinds
+    dt: float
+    sidecar: Sidecar
+    warnings: list[CheckWarning]
+
+
+#: Every kind the format takes.
+FORMAT_KINDS = Accepted(tuple(INPUT_KINDS), tuple(OUTPUT_KINDS), "the format",
+                        "time, one input and one output column")
+
+
+def _check_accepted(path: Path, header: list[str], accept: Accepted) -> None:
+    """DataError at the header when the input or output column is missing, showing the header
+    read, or is of a kind the command does not take (``accept``), saying why."""
+    for role, allowed, every in (("input", accept.inputs, INPUT_KINDS),
+                                 ("output", accept.outputs, OUTPUT_KINDS)):
+        present = [k for k in every if k in header]
+        if present and present[0] in allowed or len(present) > 1:
+            continue  # recording_kinds names a doubled kind
+        need = " or ".join(f"{k} ({UNITS[k]})" for k in allowed)
+        if present:
+            raise DataError(path, f"{accept.purpose} needs the {role} {need}: {accept.why}; "
+                            f"this file has {present[0]}", line=1, column=present[0])
+        raise DataError(path, f"missing column: {accept.purpose} needs an {role} column, "
+                        f"{need} ({accept.why}); the header reads {_shown(','.join(header))}",
+                        line=1, column=allowed[0])
+
+
+def read_checked_recording(path: str | Path, known: Mapping[str, float] | None = None,
+                           known_from: str = "the sidecar", *,
+                           accept: Accepted | None = None) -> CheckedRecording:
+    """Read a converted recording and check it as an instrument would (``data.checks``).
+
+    The format: time (s), one input and one output column, extras allowed. Input
+    ``base_acc`` (m/s^2) or ``force`` (N); output ``rel_acc`` (m/s^2) or ``rel_disp`` (m)
+    (``harvester.data.recording.recording_kinds`` tells which from the columns); ``accept``
+    narrows them for a command that takes fewer, saying why. Every column must be numeric with
+    no NaN or empty rows, the time base uniform (``signals.time_base``), at least 64 samples.
+    Then ``checks.check_recording``: absurd magnitudes, a clock in ms, gravity left in or mm,
+    dead channels, saturation, a unit slip judged from the physics with ``known`` M, m, k
+    (default: the sidecar's); its warnings are returned, not logged.
     """
     path = Path(path)
+    sidecar = read_sidecar(path)
     header, rows, lines = _read_rows(path)
+    check_annotations(header, path)
     if "time" not in header:
-        raise DataError(path, "missing column (need time, an input and an output column)",
+        raise DataError(path, f"missing column: the header reads {_shown(','.join(header))}; "
+                        "expected time (s), an input (base_acc in m/s^2 or force in N) and an "
+                        "output (rel_acc in m/s^2 or rel_disp in m), comma-separated",
                         line=1, column="time")
+    _check_accepted(path, header, accept or FORMAT_KINDS)
     kinds = recording_kinds(header, path)
     df = _numeric_table(path, header, rows, lines)
     if len(df) < MIN_SAMPLES:
-        raise DataError(path, f"{len(df)} samples; at least {MIN_SAMPLES} are needed")
-    _uniform_time(path, df, header, rows, lines)
-    check_plausible(df, kinds, path)
-    return df
+        raise DataError(path, f"{len(df)} samples" + (" (no data rows after the header)"
+                        if not rows else "") + f"; at least {MIN_SAMPLES} are needed")
+    dt, _ = _uniform_time(path, df, header, rows, lines)
+    known = sidecar.known if known is None else known
+    found = check_recording(df, kinds, dt, path, known, lines, known_from,
+                            sidecar.filtered_at_hz)
+    return CheckedRecording(df, kinds, dt, sidecar, found)
+
+
+def read_recording(path: str | Path) -> pd.DataFrame:
+    """Read a converted recording (:func:`read_checked_recording`), logging the checks'
+    warnings; for the workflow's scripts."""
+    checked = read_checked_recording(path)
+    for warning in checked.warnings:
+        log.warning("%s", warning)
+    return checked.data
 
 
 def read_static_test(csv_path: str | Path,

@@ -92,6 +92,16 @@ class RecordingKinds:
         return UNITS[self.output_kind]
 
 
+@dataclass(frozen=True)
+class Accepted:
+    """The kinds a command takes when it takes fewer than the format allows, and why."""
+
+    inputs: tuple[str, ...]
+    outputs: tuple[str, ...]
+    purpose: str  # e.g. "harvester diagnose"
+    why: str  # e.g. "its detection works on accelerations only"
+
+
 def _annotated(name: str) -> tuple[str, str] | None:
     """(kind, unit) of a header such as ``rel_disp_mm`` or ``base_acc [g]``, else None."""
     if name in UNITS:
@@ -102,7 +112,7 @@ def _annotated(name: str) -> tuple[str, str] | None:
     return match["kind"].lower(), match["unit"]
 
 
-def _check_annotations(columns: Iterable[str], source: str | Path) -> None:
+def check_annotations(columns: Iterable[str], source: str | Path) -> None:
     """DataError for a kind column whose header names a unit (``rel_disp_mm``)."""
     for name in columns:
         found = _annotated(name)
@@ -126,7 +136,7 @@ def recording_kinds(columns: Iterable[str] | pd.DataFrame,
     appears twice, or if a kind column names a unit other than the format's.
     """
     cols = list(columns.columns if isinstance(columns, pd.DataFrame) else columns)
-    _check_annotations(cols, source)
+    check_annotations(cols, source)
     found = {}
     for role, kinds in (("input", INPUT_KINDS), ("output", OUTPUT_KINDS)):
         present = [k for k in kinds if k in cols]

@@ -83,8 +83,15 @@ def time_base(t: ArrayLike) -> tuple[float, int | None, str]:
     bad = np.flatnonzero((steps <= 0.0) | (np.abs(steps - step) > STEP_REL_TOL * step))
     if bad.size:
         i = int(bad[0])
-        why = ("time does not increase" if steps[i] <= 0.0 else
-               f"non-uniform time base: step {steps[i]:.9g} s, expected {step:.9g} s")
+        usual = float(np.median(steps))
+        if steps[i] <= 0.0:
+            why = (f"time does not increase: {t[i + 1]:.9g} s after {t[i]:.9g} s (a repeated "
+                   f"or reordered sample; the usual step is {usual:.9g} s)")
+        else:
+            why = (f"non-uniform time base: step {steps[i]:.9g} s from {t[i]:.9g} s, expected "
+                   f"{usual:.9g} s (the usual step)")
+            if steps[i] > 1.5 * usual:
+                why += f": about {steps[i] / usual - 1:.0f} samples missing"
         return step, i + 1, why
     off = np.flatnonzero(np.abs(t - (t[0] + step * np.arange(t.size))) > 0.5 * step)
     if off.size:

@@ -90,3 +90,60 @@ def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
     except (DataError, ValueError, np.linalg.LinAlgError) as err:
         log.warning("FRF damping fit failed (%s); c_m, F_c and beta priors are Table 4's", err)
     return {**specs, **stated}
+
+
+#: Lowest frequency (Hz) of the FRF fit that sets the priors of unknown M, m, k, c_m, and the
+#: top of its band as a fraction of the recording's low-pass (or Nyquist) frequency.
+FRF_BAND_LOW_HZ = 0.3
+FRF_BAND_TOP = 0.8
+
+
+def identification_priors(df: pd.DataFrame, free: tuple[str, ...],
+                          known: Mapping[str, float],
+                          given: Mapping[str, Mapping[str, float]] | None = None,
+                          lowpass_hz: float | None = None, source: str = "<recording>"
+                          ) -> tuple[dict[str, PriorSpec], list[str]]:
+    """Priors of the ``free`` parameters (and sigma) of one recording, and where each came from.
+
+    * base_acc -> rel_acc with M, m, k known: c_m, F_c, beta from the recording's FRF
+      (:func:`recording_priors`, as ``harvester diagnose`` does);
+    * otherwise the free base parameters (M, m, k, c_m) from a linear FRF fit over
+      FRF_BAND_LOW_HZ to FRF_BAND_TOP x the low-pass (``harvester.initial.frf.initial_priors``);
+    * sigma: a tenth of the output's sd (``frf.sigma_prior``); the terms' other parameters:
+      the library's defaults (set for the paper's rig);
+    * ``given`` (the sidecar's ``priors``) replace any of these.
+    """
+    from harvester.data.recording import recording_kinds
+    from harvester.data.signals import sampling_rate
+    from harvester.inference.priors import default_prior
+    from harvester.initial.frf import initial_priors, sigma_prior
+    from harvester.study.paper import TABLE1
+
+    kinds = recording_kinds(df, source)
+    specs: dict[str, PriorSpec] = {}
+    notes: list[str] = []
+    if (kinds.input_kind, kinds.output_kind) == ("base_acc", "rel_acc") and \
+            {"M", "m", "k"} <= set(known):
+        specs.update({k: v for k, v in recording_priors(df, known, {}, source).items()
+                      if k in free})
+        notes.append(f"priors of {', '.join(specs)}: from the recording's FRF with the known "
+                     "M, m, k (as harvester diagnose)")
+    base = tuple(p for p in ("M", "m", "k", "c_m") if p in free and p not in specs)
+    if base:
+        top = FRF_BAND_TOP * (lowpass_hz or 0.5 * sampling_rate(df, source))
+        fit, frf = initial_priors(df, known, base, (FRF_BAND_LOW_HZ, top), source=source)
+        specs.update({p: frf[p] for p in base})
+        notes.append(f"priors of {', '.join(base)}: a linear FRF fit over "
+                     f"{FRF_BAND_LOW_HZ:g}-{top:.3g} Hz (" + ", ".join(
+                         f"{p} = {fit.values[p]:.4g}" for p in base) + ")")
+    specs["sigma"] = sigma_prior(df)
+    rest = [p for p in free if p not in specs]
+    specs.update({p: default_prior(p) for p in rest})
+    if rest:
+        notes.append(f"priors of {', '.join(rest)}: the library's defaults (the paper's rig)")
+    for name, entry in (given or {}).items():
+        unit = specs[name].unit if name in specs else default_prior(name).unit
+        specs[name] = prior_spec(name, {"unit": unit, **entry}, TABLE1)
+    if given:
+        notes.append(f"priors of {', '.join(given)}: given in the sidecar")
+    return specs, notes

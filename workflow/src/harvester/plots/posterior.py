@@ -16,14 +16,18 @@ SIMULATED_NOTE = "recordings: virtual rig (simulated)"
 UNITS = {"c_m": "N s/m", "F_c": "N", "beta": "s/m", "sigma": "m/s$^2$"}
 
 
-def label(name: str) -> str:
-    unit = UNITS.get(name)
+def label(name: str, units: dict[str, str] | None = None) -> str:
+    unit = (units or {}).get(name) or UNITS.get(name)
     return f"{name} ({unit})" if unit else name
 
 
 def pair_plot(samples: np.ndarray, names: list[str], path: str | Path, title: str,
-              paper: dict[str, float] | None = None, truth: dict[str, float] | None = None) -> None:
-    """Pairwise scatter of posterior samples (grey), paper's mean (black cross), rig truth (red)."""
+              paper: dict[str, float] | None = None, truth: dict[str, float] | None = None,
+              note: str = SIMULATED_NOTE, units: dict[str, str] | None = None) -> None:
+    """Pairwise scatter of posterior samples (grey), paper's mean (black cross), rig truth (red).
+
+    ``note``: the subtitle (default: the recordings are simulated); ``units``: axis units by
+    parameter name beyond :data:`UNITS`."""
     n = len(names)
     size = 2.4 * max(n, 2)
     fig, axes = plt.subplots(n, n, figsize=(size, size), squeeze=False)
@@ -42,13 +46,14 @@ def pair_plot(samples: np.ndarray, names: list[str], path: str | Path, title: st
                 _mark_2d(ax, names[j], names[i], paper, "k", "x")
                 _mark_2d(ax, names[j], names[i], truth, "tab:red", "+")
             if i == n - 1:
-                ax.set_xlabel(label(names[j]))
+                ax.set_xlabel(label(names[j], units))
             if j == 0 and i > 0:
-                ax.set_ylabel(label(names[i]))
+                ax.set_ylabel(label(names[i], units))
     handles = [plt.Line2D([], [], color="k", marker="x", ls="--", label="paper (posterior mean)"),
                plt.Line2D([], [], color="tab:red", marker="+", ls=":", label="virtual rig truth")]
-    fig.legend(handles=handles, loc="upper right", frameon=False)
-    fig.suptitle(f"{title}\n{SIMULATED_NOTE}", fontsize=10)
+    if paper or truth:
+        fig.legend(handles=handles, loc="upper right", frameon=False)
+    fig.suptitle(f"{title}\n{note}", fontsize=10)
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=120, format="png")

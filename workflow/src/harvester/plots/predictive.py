@@ -16,8 +16,12 @@ from harvester.inference.predictive import PredictiveBand  # noqa: E402
 
 
 def response_figure(band: PredictiveBand, measured: np.ndarray, path: str | Path, title: str,
-                    window: tuple[float, float] | None = None, k: float = 3.0) -> None:
-    """Measured z'' in grey, model mean in black, +-k sd bounds shaded (two kinds, labelled)."""
+                    window: tuple[float, float] | None = None, k: float = 3.0,
+                    note: str = SIMULATED_NOTE,
+                    ylabel: str = "relative acceleration $\\ddot z$ (m/s$^2$)",
+                    measured_label: str = "measured (virtual rig)") -> None:
+    """Measured output in grey, model mean in black, +-k sd bounds shaded (two kinds,
+    labelled); ``note`` is the subtitle, ``ylabel`` the output with its unit."""
     t = band.time
     sel = slice(None) if window is None else (t >= window[0]) & (t <= window[1])
     width = 11 if window is None or (window[1] - window[0]) > 20 else 9
@@ -29,11 +33,11 @@ def response_figure(band: PredictiveBand, measured: np.ndarray, path: str | Path
         ax.fill_between(t[sel], mean - k * sd, mean + k * sd, color=color, alpha=alpha, lw=0,
                         label=f"mean $\\pm${k:g} sd ({what})")
     lw = 0.6 if window is None else 1.0
-    ax.plot(t[sel], measured[sel], color="0.6", lw=lw, label="measured (virtual rig)")
+    ax.plot(t[sel], measured[sel], color="0.6", lw=lw, label=measured_label)
     ax.plot(t[sel], mean, color="k", lw=lw, label="model mean")
     ax.set_xlabel("time (s)")
-    ax.set_ylabel("relative acceleration $\\ddot z$ (m/s$^2$)")
-    ax.set_title(f"{title}\n{SIMULATED_NOTE}", fontsize=10)
+    ax.set_ylabel(ylabel)
+    ax.set_title(f"{title}\n{note}", fontsize=10)
     ax.legend(loc="upper right", fontsize=8, ncol=2, frameon=False)
     ax.margins(x=0)
     fig.tight_layout()

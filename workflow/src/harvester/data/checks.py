@@ -1,0 +1,429 @@
+"""Instrument-style checks of a recording: what cannot be right, and what only looks wrong.
+
+A recording that passed the format's checks (``daq.read_recording``: header, numbers, uniform
+time) is looked at as an instrument would look at its own channels before anyone trusts
+them. What cannot be right raises :class:`~harvester.data.errors.DataError` naming the file,
+the line or column, what was found and what was expected; what may be right but looks wrong
+is returned as a :class:`CheckWarning` whose text carries the evidence.
+
+========================= ===================================================== ==========
+check                     evidence                                              outcome
+========================= ===================================================== ==========
+absurd magnitude          a value beyond any sensor of the kind (1e5 m/s^2,     error
+                          1e8 N, 1e3 m), at its line
+clock                     sampling rate below MIN_SAMPLING_HZ (a time column    error
+                          in ms); the device's natural frequency sqrt(k/M)
+                          beyond what the rate resolves                         warning
+dead channel              input or output constant over the whole record        error
+flat stretch              a run of equal values of an acceleration or force     warning
+                          over FLAT_RUN_S (a dropout)
+saturation                runs of equal extreme values (a clipped sensor or     error above
+                          ADC): samples, share, level, longest run              SATURATED_
+                                                                                SHARE, else
+                                                                                warning
+spike                     a sample SPIKE_ROBUST_SD robust sd from the median    warning
+unit slip                 the output/input gain above resonance against the     error: median
+                          bound M, m, k allow (m/M for base_acc -> rel_acc):    above
+                          g against m/s^2, mm against m, kN against N           UNIT_RATIO;
+                          (friction lowers the gain, so heavy friction can      warning: 90th
+                          hide a slip; a low gain needs M, m known)             percentile
+                                                                                below 1/(2 it)
+========================= ===================================================== ==========
+
+Reach of the unit check, measured (``tests/test_input_checks.py``; the ratio is the median
+gain over the bound): the rig's tanh device 0.8 (base_acc in g: 7.9; rel_acc in g: 90th
+percentile 0.10); a device with 30 N of friction under 8 m/s^2 0.33 (in g: 3.2, caught), under
+4 m/s^2 0.20 (in g: 2.0, NOT caught); the bundled records 0.4-0.9 and the detection grid's
+scenarios 0.3-1.0 raise nothing.
+
+Gravity left in an acceleration and displacements in mm are ``recording.check_plausible``'s
+(called from here). The sidecar (``RECORDING.yaml``) is checked by ``harvester.data.sidecar``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy import signal
+
+from harvester.data.errors import DataError
+from harvester.data.recording import G, RecordingKinds, check_plausible
+
+#: Largest magnitude a column of each kind can hold (SI units): beyond any sensor's range.
+MAX_MAGNITUDE: dict[str, float] = {"base_acc": 1.0e5, "rel_acc": 1.0e5, "force": 1.0e8,
+                                   "rel_disp": 1.0e3, "time": 1.0e9}
+#: Lowest sampling rate (Hz) of a vibration recording the method can use.
+MIN_SAMPLING_HZ = 10.0
+#: A run of equal values this long (s, and at least FLAT_RUN_SAMPLES) in an acceleration or a
+#: force is reported as a dropout.
+FLAT_RUN_S = 0.5
+FLAT_RUN_SAMPLES = 32
+#: Runs of at least this many equal samples at a channel's extreme count as saturated.
+SATURATED_RUN = 3
+#: Share of saturated samples above which an acceleration or force cannot be fitted.
+SATURATED_SHARE = 0.01
+#: A sample this many robust sd (1.4826 x MAD) from the median is reported as a spike.
+SPIKE_ROBUST_SD = 100.0
+#: Measured gain above resonance over the physical bound beyond which a unit slipped.
+UNIT_RATIO = 3.0
+#: FRF lines used by the unit check: coherence at least this, frequency at least
+#: RESONANCE_MARGIN x the natural frequency.
+MIN_COHERENCE = 0.5
+RESONANCE_MARGIN = 3.0
+#: The unit check needs Welch segments of at least MIN_SEGMENT_S (s, four of them) and
+#: MIN_LINES such lines.
+MIN_SEGMENT_S = 0.5
+MIN_LINES = 8
+#: Unit factors a ratio is compared with, and what each means.
+UNIT_FACTORS: dict[float, str] = {G: "g (9.81)", 1000.0: "1000 (mm against m, kN against N, "
+                                                       "ms against s)"}
+
+
+@dataclass(frozen=True)
+class CheckWarning:
+    """Something that may be right but looks wrong, with its evidence."""
+
+    source: str
+    check: str
+    message: str
+    column: str | None = None
+    line: int | None = None
+
+    def __str__(self) -> str:
+        where = self.source
+        if self.line is not None:
+            where += f", line {self.line}"
+        if self.column is not None:
+            where += f", column '{self.column}'"
+        return f"{where}: {self.message}"
+
+
+def _line(lines: Sequence[int] | None, i: int) -> int:
+    """File line of row i (the header is line 1)."""
+    return int(lines[i]) if lines is not None else i + 2
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """(start, length) of each run of True in ``mask``."""
+    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    return list(zip(starts.tolist(), (stops - starts).tolist()))
+
+
+def _equal_runs(x: np.ndarray) -> list[tuple[int, int]]:
+    """(start, length) of each run of at least 2 equal consecutive values."""
+    same = np.concatenate([[False], x[1:] == x[:-1]])
+    return [(s - 1, n + 1) for s, n in _runs(same)]
+
+
+# --------------------------------------------------------------------------- errors
+
+
+def check_magnitudes(df: pd.DataFrame, kinds: RecordingKinds, source: str | Path,
+                     lines: Sequence[int] | None = None) -> None:
+    """DataError at the first value beyond :data:`MAX_MAGNITUDE` of its column's kind."""
+    for name in ("time", kinds.input_kind, kinds.output_kind):
+        x = df[name].to_numpy(dtype=float)
+        bad = np.flatnonzero(np.abs(x) > MAX_MAGNITUDE[name])
+        if bad.size:
+            i = int(bad[0])
+            unit = "s" if name == "time" else kinds.input_unit if name == kinds.input_kind \
+                else kinds.output_unit
+            raise DataError(source, f"{x[i]:.4g} {unit}: beyond any sensor's range "
+                            f"(|{name}| <= {MAX_MAGNITUDE[name]:g} {unit}); a corrupted cell or "
+                            f"another unit ({bad.size} such value(s))", line=_line(lines, i),
+                            column=name)
+
+
+def check_sampling_rate(dt: float, source: str | Path, line: int = 3) -> None:
+    """DataError if the time step gives a rate below :data:`MIN_SAMPLING_HZ`."""
+    fs = 1.0 / dt
+    if fs >= MIN_SAMPLING_HZ:
+        return
+    hint = (f"; a time column in ms instead of s gives this (in s the rate would be "
+            f"{1000.0 * fs:.6g} Hz)" if 1000.0 * fs >= MIN_SAMPLING_HZ else "")
+    raise DataError(source, f"time step {dt:.6g} s, a sampling rate of {fs:.4g} Hz: below the "
+                    f"{MIN_SAMPLING_HZ:g} Hz a vibration recording needs (time must be in s)"
+                    f"{hint}", line=line, column="time")
+
+
+def check_live_channels(df: pd.DataFrame, kinds: RecordingKinds, source: str | Path) -> None:
+    """DataError if the input or the output is constant over the whole record (dead)."""
+    for name, role in ((kinds.input_kind, "input"), (kinds.output_kind, "output")):
+        x = df[name].to_numpy(dtype=float)
+        if x.size and np.all(x == x[0]):
+            raise DataError(source, f"the {role} is {x[0]:g} in all {x.size} samples: a dead "
+                            "or disconnected channel; the device starts at rest, so a "
+                            "constant channel leaves nothing to identify", column=name)
+
+
+# --------------------------------------------------------------------------- warnings
+
+
+def flat_stretches(df: pd.DataFrame, kinds: RecordingKinds, dt: float, source: str | Path,
+                   lines: Sequence[int] | None = None) -> list[CheckWarning]:
+    """Runs of equal values over FLAT_RUN_S in an acceleration or force (a displacement may
+    rest while friction holds the mass), and constant extra columns."""
+    out = []
+    need = max(FLAT_RUN_SAMPLES, int(round(FLAT_RUN_S / dt)))
+    for name in df.columns:
+        if name in ("time", "rel_disp"):
+            continue
+        x = df[name].to_numpy(dtype=float)
+        if name not in (kinds.input_kind, kinds.output_kind):
+            if x.size and np.all(x == x[0]):
+                out.append(CheckWarning(str(source), "flat", f"constant ({x[0]:g}); the column "
+                                        "is not used", column=name))
+            continue
+        long = [(s, n) for s, n in _equal_runs(x) if n >= need]
+        if long:
+            s, n = max(long, key=lambda r: r[1])
+            out.append(CheckWarning(
+                str(source), "flat", f"{n} equal values ({x[s]:g}, {n * dt:.3g} s) from line "
+                f"{_line(lines, s)}; {len(long)} such stretch(es), "
+                f"{sum(r[1] for r in long) / x.size:.1%} of the record: a dropout or a sensor "
+                "that stopped", column=name, line=_line(lines, s)))
+    return out
+
+
+def saturation(df: pd.DataFrame, kinds: RecordingKinds, dt: float, source: str | Path,
+               lines: Sequence[int] | None = None) -> list[CheckWarning]:
+    """Runs of SATURATED_RUN or more equal samples at a channel's largest or smallest value.
+
+    DataError when more than SATURATED_SHARE of an acceleration's or a force's samples are
+    saturated (the model cannot reproduce a clipped signal); a warning otherwise (and for a
+    displacement, which may rest at a turning point while friction holds it).
+    """
+    out = []
+    for name in (kinds.input_kind, kinds.output_kind):
+        x = df[name].to_numpy(dtype=float)
+        runs = [(s, n) for level in (x.max(), x.min())
+                for s, n in _runs(x == level) if n >= SATURATED_RUN]
+        if not runs:
+            continue
+        count = sum(n for _, n in runs)
+        first, longest = min(r[0] for r in runs), max(r[1] for r in runs)
+        levels = sorted({float(x[s]) for s, _ in runs})
+        what = (f"{count} samples ({count / x.size:.1%}) sit at the extreme value(s) "
+                f"{', '.join(f'{v:g}' for v in levels)} in runs of up to {longest} samples "
+                f"({longest * dt:.3g} s), first at line {_line(lines, first)}: a clipped "
+                "sensor or an ADC at the end of its range")
+        if name != "rel_disp" and count / x.size > SATURATED_SHARE:
+            raise DataError(source, f"saturated: {what}; at most {SATURATED_SHARE:.0%} can be "
+                            "tolerated: record again with a larger range", column=name)
+        out.append(CheckWarning(str(source), "saturation", what, column=name,
+                                line=_line(lines, first)))
+    return out
+
+
+def spikes(df: pd.DataFrame, kinds: RecordingKinds, source: str | Path,
+           lines: Sequence[int] | None = None) -> list[CheckWarning]:
+    """Samples more than SPIKE_ROBUST_SD robust sd from the channel's median."""
+    out = []
+    for name in (kinds.input_kind, kinds.output_kind):
+        x = df[name].to_numpy(dtype=float)
+        med = np.median(x)
+        sd = 1.4826 * np.median(np.abs(x - med))
+        if not sd > 0:
+            continue
+        far = np.flatnonzero(np.abs(x - med) > SPIKE_ROBUST_SD * sd)
+        if far.size:
+            i = int(far[np.argmax(np.abs(x[far] - med))])
+            out.append(CheckWarning(
+                str(source), "spike", f"{far.size} sample(s) more than {SPIKE_ROBUST_SD:g} "
+                f"robust sd from the median ({med:.4g}, sd {sd:.4g}); the largest is "
+                f"{x[i]:.4g} ({abs(x[i] - med) / sd:.0f} sd): a glitch or a corrupted cell",
+                column=name, line=_line(lines, i)))
+    return out
+
+
+# --------------------------------------------------------------------------- physics
+
+
+def _factor_named(ratio: float) -> str:
+    """The unit factor a gain ratio is close to (within 2x), or ''."""
+    r = max(ratio, 1.0 / ratio)
+    for factor, what in UNIT_FACTORS.items():
+        if factor / 2.0 < r < factor * 2.0:
+            return f", close to a factor {what}"
+    return ""
+
+
+def _winsorised(x: np.ndarray) -> np.ndarray:
+    """x with samples beyond SPIKE_ROBUST_SD robust sd of the median pulled to that bound
+    (so that one glitch does not decide a spectrum)."""
+    med = np.median(x)
+    sd = 1.4826 * np.median(np.abs(x - med))
+    return np.clip(x, med - SPIKE_ROBUST_SD * sd, med + SPIKE_ROBUST_SD * sd) if sd > 0 else x
+
+
+def gain_above_resonance(df: pd.DataFrame, kinds: RecordingKinds, dt: float,
+                         known: Mapping[str, float],
+                         lowpass_hz: float | None = None) -> dict | None:
+    """|output / input| above resonance against what a passive device allows there.
+
+    Measured: the median over FRF lines (Welch, 2 s segments, at least four and at least
+    MIN_SEGMENT_S long; at least MIN_LINES lines) with coherence >= MIN_COHERENCE
+    above RESONANCE_MARGIN x the natural frequency sqrt(k/M) / 2 pi (without M and k: the
+    upper half of the coherent lines), below 0.4 x the rate and 0.8 x ``lowpass_hz`` (a
+    low-pass of the output alone lowers the gain above it), of |H|, times w^2 for a
+    displacement output (and its 90th percentile over the lines). Bound: eq. (1)
+    with any damping or friction, |z''/y''| <= (m/M) w^2 / (w^2 - w_n^2) for a base input
+    (m/M <= 1 when not known: M = m + J (2 pi / l)^2), |z''/F| <= (1/M) w^2 / (w^2 - w_n^2)
+    for a force input (None without M). Returns None when nothing can be judged.
+    """
+    M, m, k = (known.get(p) for p in ("M", "m", "k"))
+    if kinds.input_kind == "force" and M is None:
+        return None
+    scale = (m / M if M and m else 1.0) if kinds.input_kind == "base_acc" else 1.0 / M
+    u, y = (_winsorised(df[c].to_numpy(float)) for c in (kinds.input_kind, kinds.output_kind))
+    fs = 1.0 / dt
+    nper = int(min(round(2.0 * fs), u.size // 4))
+    if nper < MIN_SEGMENT_S * fs:
+        return None  # too short a record for a spectrum
+    kw = {"fs": fs, "nperseg": nper, "noverlap": nper // 2, "detrend": "linear"}
+    f, s_uu = signal.welch(u, **kw)
+    _, s_yy = signal.welch(y, **kw)
+    _, s_uy = signal.csd(u, y, **kw)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        coh = np.abs(s_uy) ** 2 / (s_uu * s_yy)
+        gain = np.abs(s_uy) / s_uu * ((2 * np.pi * f) ** 2 if kinds.output_kind == "rel_disp"
+                                      else 1.0)
+    top = min(0.4 * fs, 0.8 * lowpass_hz) if lowpass_hz else 0.4 * fs
+    ok = (f > 0) & (f < top) & (coh >= MIN_COHERENCE)
+    f_n = np.sqrt(k / M) / (2 * np.pi) if M and k else None
+    if f_n:
+        ok &= f > RESONANCE_MARGIN * f_n
+    elif ok.any():
+        ok &= f > np.median(f[ok])
+    if ok.sum() < MIN_LINES:
+        return {"lines": int(ok.sum()), "coherence": float(np.nanmax(coh[f > 0]))}
+    w2 = (2 * np.pi * f[ok]) ** 2
+    bound = scale * w2 / (w2 - (2 * np.pi * f_n) ** 2 if f_n else w2)
+    ratio = gain[ok] / bound
+    return {"lines": int(ok.sum()), "band_hz": (float(f[ok][0]), float(f[ok][-1])),
+            "gain": float(np.median(gain[ok])), "ratio": float(np.median(ratio)),
+            "ratio_p90": float(np.quantile(ratio, 0.9)), "scale": float(scale),
+            "known": bool(f_n)}
+
+
+def check_units_by_physics(df: pd.DataFrame, kinds: RecordingKinds, dt: float,
+                           known: Mapping[str, float], source: str | Path,
+                           known_from: str = "the sidecar",
+                           lowpass_hz: float | None = None) -> list[CheckWarning]:
+    """DataError when the gain above resonance (:func:`gain_above_resonance`, its median over
+    the lines) exceeds what a passive device allows by UNIT_RATIO (a unit slipped, or the
+    sidecar's M, m are wrong); a warning when, with M (and m) known, even its 90th percentile
+    is below 1 / (2 UNIT_RATIO) of it (friction lowers the gain most at low frequencies), or
+    when input and output do not cohere."""
+    g = gain_above_resonance(df, kinds, dt, known, lowpass_hz)
+    if g is None:
+        return []
+    pair = f"|{kinds.output_kind} / {kinds.input_kind}|"
+    if "ratio" not in g:
+        if g["coherence"] >= MIN_COHERENCE:
+            return []  # no line above resonance: the clock check speaks
+        return [CheckWarning(str(source), "unit", f"{kinds.output_kind} hardly follows "
+                             f"{kinds.input_kind} (largest coherence {g['coherence']:.2f}): "
+                             "friction holding the device, or unrelated or swapped channels")]
+    name = "m/M" if kinds.input_kind == "base_acc" else "1/M"
+    what = (f"{name} = {g['scale']:.4g}, from {known_from}" if "M" in known else
+            f"{name} <= 1: M, m not known") + (", times w^2 / (w^2 - w_n^2)" if g["known"] else "")
+    evidence = (f"above resonance ({g['band_hz'][0]:.3g}-{g['band_hz'][1]:.3g} Hz, {g['lines']} "
+                f"FRF lines with coherence >= {MIN_COHERENCE}) the median {pair} is "
+                f"{g['gain']:.4g}, {g['ratio']:.3g} times the most a passive device allows "
+                f"there ({what})")
+    if g["ratio"] > UNIT_RATIO:
+        raise DataError(source, f"{evidence}{_factor_named(g['ratio'])}: a unit slipped "
+                        f"({kinds.input_kind} must be in {kinds.input_unit}, "
+                        f"{kinds.output_kind} in {kinds.output_unit}; e.g. "
+                        f"{'base_acc in g' if kinds.input_kind == 'base_acc' else 'force in kN'}"
+                        f"), or the M, m in {known_from} are wrong")
+    scale_known = "M" in known and ("m" in known or kinds.input_kind == "force")
+    if scale_known and g["ratio_p90"] < 1.0 / (2.0 * UNIT_RATIO):
+        return [CheckWarning(str(source), "unit", f"{evidence}; even its 90th percentile is "
+                             f"{g['ratio_p90']:.3g} times it{_factor_named(g['ratio_p90'])}: "
+                             "friction holding the mass, an output low-passed below these "
+                             "frequencies (give filtered_at_hz), or a unit slip (rel_acc in g, "
+                             "base_acc in mm/s^2, force in kN)")]
+    return []
+
+
+def check_clock_against_device(dt: float, known: Mapping[str, float], source: str | Path,
+                               known_from: str = "the sidecar") -> list[CheckWarning]:
+    """A warning when the device's natural frequency sqrt(k/M) / 2 pi is above a quarter of
+    the sampling rate (a clock off by 1000, or k and M wrong)."""
+    M, k = known.get("M"), known.get("k")
+    if not (M and k):
+        return []
+    f_n, fs = np.sqrt(k / M) / (2 * np.pi), 1.0 / dt
+    if f_n <= 0.25 * fs:
+        return []
+    return [CheckWarning(str(source), "clock", f"the device's natural frequency sqrt(k/M) / "
+                         f"2 pi = {f_n:.3g} Hz (k, M from {known_from}) is above a quarter of "
+                         f"the {fs:.4g} Hz sampling rate: the clock does not match the device "
+                         "(time in ms instead of s?)", column="time")]
+
+
+# --------------------------------------------------------------------------- entry points
+
+
+def check_recording(df: pd.DataFrame, kinds: RecordingKinds, dt: float, source: str | Path,
+                    known: Mapping[str, float] | None = None,
+                    lines: Sequence[int] | None = None,
+                    known_from: str = "the sidecar",
+                    lowpass_hz: float | None = None) -> list[CheckWarning]:
+    """Every check of a recording whose format is valid; returns the warnings.
+
+    ``dt``: its time step (s); ``known``: the device's M, m, k where known (the sidecar's,
+    named by ``known_from``), for the physics checks; ``lines``: file line of each row;
+    ``lowpass_hz``: a low-pass the output went through (the sidecar's filtered_at_hz).
+    Raises DataError for what cannot be right, in this order: absurd magnitudes, sampling
+    rate, gravity left in or mm (``recording.check_plausible``), dead channels, saturation,
+    a unit slip against the physics.
+    """
+    known = dict(known or {})
+    check_magnitudes(df, kinds, source, lines)
+    check_sampling_rate(dt, source, _line(lines, 1))
+    check_plausible(df, kinds, source)
+    check_live_channels(df, kinds, source)
+    found = saturation(df, kinds, dt, source, lines)
+    found += flat_stretches(df, kinds, dt, source, lines)
+    found += spikes(df, kinds, source, lines)
+    found += check_clock_against_device(dt, known, source, known_from)
+    found += check_units_by_physics(df, kinds, dt, known, source, known_from, lowpass_hz)
+    return found
+
+
+def check_frame(df: pd.DataFrame, source: str | Path, columns: Sequence[str]) -> float:
+    """A recording held in memory: a table with ``columns``, finite numbers, a uniform time
+    base; returns the time step (s). DataError naming the column and row (1 = header)."""
+    from harvester.data.signals import uniform_step
+    if not isinstance(df, pd.DataFrame):
+        raise DataError(source, "expected a table with columns " + ", ".join(columns))
+    for c in columns:
+        if c not in df.columns:
+            raise DataError(source, f"missing column (need {', '.join(columns)})", column=c)
+    for c in columns:
+        x = pd.to_numeric(df[c], errors="coerce").to_numpy(dtype=float)
+        bad = np.flatnonzero(~np.isfinite(x))
+        if bad.size:
+            raise DataError(source, f"not a finite number at row {int(bad[0]) + 1}", column=c)
+    return uniform_step(df["time"].to_numpy(dtype=float), source)
+
+
+def check_duration(df: pd.DataFrame, dt: float, source: str | Path, lead_in_s: float,
+                   analysed_s: float, holdout_fraction: float) -> None:
+    """DataError unless the record holds the lead-in, ``analysed_s`` analysed seconds plus
+    the held-out share, and 0.5 s of filter end effects."""
+    t = df["time"].to_numpy(dtype=float)
+    need = lead_in_s + analysed_s / (1.0 - holdout_fraction) + 0.5
+    if t[-1] - t[0] + dt < need - 1e-9:
+        held = f", {holdout_fraction:.0%} held out" if holdout_fraction > 0 else ""
+        raise DataError(source, f"too short: {t[-1] - t[0] + dt:.2f} s; the diagnosis needs at "
+                        f"least {need:.2f} s ({lead_in_s:g} s lead-in, {analysed_s:g} s "
+                        f"analysed{held}, 0.5 s of filter end effects)")

@@ -1,0 +1,188 @@
+"""The sidecar of a recording, ``RECORDING.yaml``: what is known about the device.
+
+Keys (all optional):
+
+============== ====== ===================================================================
+key            unit   meaning
+============== ====== ===================================================================
+M              kg     effective mass m + J (2 pi / l)^2 (eq. 2)
+m              kg     oscillating mass (M >= m)
+k              N/m    spring stiffness
+priors                ``{parameter: {mean, sd}}``, e.g. a static test's ``F_c``
+filtered_at_hz Hz     cut-off of a zero-phase low-pass the recording already went through
+============== ====== ===================================================================
+
+Parameters the sidecar does not give are identified where the method can (``harvester
+identify``), or must be given, or assumed explicitly (``--paper-device``: the paper's Table 1),
+where it cannot (``harvester diagnose``): :func:`resolve_known` says which and why, and what
+was assumed is logged and written to the output.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from harvester.data.errors import DataError
+
+log = logging.getLogger("harvester.data.sidecar")
+
+#: Keys of a sidecar and what each holds.
+SIDECAR_KEYS: dict[str, str] = {
+    "M": "effective mass (kg)", "m": "oscillating mass (kg)", "k": "stiffness (N/m)",
+    "priors": "{parameter: {mean, sd}}", "filtered_at_hz": "low-pass already applied (Hz)",
+}
+#: Device parameters a sidecar may give, with their units.
+DEVICE_PARAMETERS: dict[str, str] = {"M": "kg", "m": "kg", "k": "N/m"}
+
+
+@dataclass(frozen=True)
+class Sidecar:
+    """A recording's sidecar as read: ``found`` False when there is none (all empty)."""
+
+    path: Path
+    found: bool = False
+    known: dict[str, float] = field(default_factory=dict)
+    priors: dict[str, dict[str, float]] = field(default_factory=dict)
+    filtered_at_hz: float | None = None
+
+    def summary(self) -> dict[str, Any]:
+        """For run.json: where it is and what it gave."""
+        return {"path": str(self.path), "found": self.found, "known": dict(self.known),
+                "priors": dict(self.priors), "filtered_at_hz": self.filtered_at_hz}
+
+
+def sidecar_path(recording: str | Path) -> Path:
+    """``RECORDING.yaml`` beside ``RECORDING.csv``."""
+    return Path(recording).with_suffix(".yaml")
+
+
+def _key_lines(text: str) -> dict[str, int]:
+    """1-based line of each top-level key of a YAML mapping ({} if not a mapping)."""
+    import yaml
+    node = yaml.compose(text)
+    if not isinstance(node, yaml.MappingNode):
+        return {}
+    return {str(k.value): k.start_mark.line + 1 for k, _ in node.value}
+
+
+def _positive(path: Path, key: str, value: Any, line: int | None) -> float:
+    if isinstance(value, str):  # YAML 1.1 reads 2.5e7 (no sign in the exponent) as text
+        try:
+            value = float(value)
+        except ValueError:
+            pass
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0 \
+            or value == float("inf"):
+        raise DataError(path, f"'{key}' must be a positive number ({SIDECAR_KEYS[key]}), got "
+                        f"{value!r}", line=line)
+    return float(value)
+
+
+def _priors(path: Path, priors: Any, line: int | None) -> dict[str, dict[str, float]]:
+    if not isinstance(priors, dict):
+        raise DataError(path, f"'priors' must map parameter names to {{mean, sd}}, got "
+                        f"{priors!r}", line=line)
+    out = {}
+    for name, spec in priors.items():
+        ok = isinstance(spec, dict) and {"mean", "sd"} <= set(spec) and all(
+            isinstance(spec[k], (int, float)) and not isinstance(spec[k], bool)
+            for k in ("mean", "sd")) and spec["sd"] > 0
+        if not ok:
+            raise DataError(path, f"priors.{name} must be {{mean: number, sd: positive "
+                            f"number}}, got {spec!r}", line=line)
+        out[str(name)] = {k: float(v) for k, v in spec.items()}
+    return out
+
+
+def read_sidecar(recording: str | Path) -> Sidecar:
+    """Read and check the sidecar beside ``recording`` (none: an empty Sidecar).
+
+    DataError (file and line) for invalid YAML, a non-mapping, an unknown key, a value that
+    is not a positive number, malformed priors, or m > M (M = m + J (2 pi / l)^2 >= m).
+    """
+    import yaml
+    path = sidecar_path(recording)
+    if not path.exists():
+        return Sidecar(path)
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+        meta, lines = yaml.safe_load(text), _key_lines(text)
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        raise DataError(path, f"invalid YAML: {getattr(err, 'problem', None) or err}",
+                        line=mark.line + 1 if mark else None) from None
+    except (OSError, UnicodeDecodeError) as err:
+        raise DataError(path, f"cannot read: {err}") from None
+    if meta is None:
+        return Sidecar(path, found=True)
+    if not isinstance(meta, dict):
+        raise DataError(path, f"expected a mapping with keys {', '.join(SIDECAR_KEYS)}, got "
+                        f"{type(meta).__name__}", line=1)
+    unknown = sorted(str(k) for k in meta if k not in SIDECAR_KEYS)
+    if unknown:
+        raise DataError(path, f"unknown key(s) {unknown}; allowed: "
+                        + ", ".join(f"{k} ({v})" for k, v in SIDECAR_KEYS.items()),
+                        line=lines.get(unknown[0]))
+    known = {k: _positive(path, k, meta[k], lines.get(k)) for k in DEVICE_PARAMETERS if k in meta}
+    if "M" in known and "m" in known and known["m"] > known["M"]:
+        raise DataError(path, f"m = {known['m']:g} kg > M = {known['M']:g} kg: impossible, the "
+                        "effective mass M = m + J (2 pi / l)^2 includes m", line=lines.get("m"))
+    cutoff = meta.get("filtered_at_hz")
+    return Sidecar(path, True, known, _priors(path, meta.get("priors", {}), lines.get("priors")),
+                   None if cutoff is None else _positive(path, "filtered_at_hz", cutoff,
+                                                         lines.get("filtered_at_hz")))
+
+
+@dataclass(frozen=True)
+class KnownParameters:
+    """The device parameters a command uses: ``values`` (all), ``given`` (by the sidecar),
+    ``assumed`` (defaults filled in, and where they come from); the others are left to the
+    identification."""
+
+    values: dict[str, float]
+    given: dict[str, float]
+    assumed: dict[str, float]
+    assumed_from: str
+
+    def notes(self, sidecar: Sidecar) -> list[str]:
+        """What was known, assumed and identified, in words (for the log and the output)."""
+        where = sidecar.path if sidecar.found else f"no sidecar ({sidecar.path} not found)"
+        out = [f"device parameters from {where}: " + (", ".join(
+            f"{k} = {v:g} {DEVICE_PARAMETERS[k]}" for k, v in self.given.items()) or "none")]
+        if self.assumed:
+            out.append("ASSUMED (not measured): " + ", ".join(
+                f"{k} = {v:g} {DEVICE_PARAMETERS[k]}" for k, v in self.assumed.items())
+                + f" from {self.assumed_from}")
+        return out
+
+    @property
+    def source(self) -> str:
+        """Where the values come from, for messages."""
+        return "the sidecar" + (f" and {self.assumed_from} (assumed)" if self.assumed else "")
+
+    def require(self, required: Sequence[str], purpose: str, sidecar: Sidecar) -> None:
+        """DataError naming the sidecar when a parameter ``purpose`` needs is neither given
+        nor assumed."""
+        missing = [p for p in required if p not in self.values]
+        if missing:
+            raise DataError(sidecar.path, f"{purpose} needs {', '.join(missing)} "
+                            f"({', '.join(DEVICE_PARAMETERS[p] for p in missing)}), "
+                            + ("which this sidecar does not give" if sidecar.found else
+                               "and there is no sidecar") + ": write them there (e.g. "
+                            f"'{missing[0]}: ...'), or pass --paper-device to assume the "
+                            "paper's Table 1 values")
+
+
+def resolve_known(sidecar: Sidecar, defaults: Mapping[str, float] | None = None,
+                  defaults_from: str = "") -> KnownParameters:
+    """The device parameters a command uses: the sidecar's, and ``defaults`` (an explicit
+    choice of the user, e.g. the paper's Table 1) for those it lacks; the others are left to
+    the identification (or refused by :meth:`KnownParameters.require`)."""
+    given = dict(sidecar.known)
+    assumed = {k: float(v) for k, v in (defaults or {}).items() if k not in given}
+    return KnownParameters({**given, **assumed}, given, assumed,
+                           defaults_from if assumed else "")
