@@ -2,6 +2,9 @@
 # Conda environment of every rule (used with --use-conda; `make study` uses .venv instead).
 ENV = "../../envs/harvester.yaml"
 RECORDS = ["training", "validation"]
+# Records with the generator's voltage channel (rig.loaded_records): regenerated, verified and
+# converted, not identified.
+LOADED_RECORDS = list(config["rig"].get("loaded_records", {}))
 RAW = config["data"]["raw_dir"]
 MODELS = config["models"]
 POSTERIOR_TABLE = {"linear": "table3", "tanh": "table5"}
@@ -42,4 +45,5 @@ def all_outputs():
         "results/figures/fig10_tanh_unseen_full.png",
         "results/tables/headline.csv",
         *[f"results/diagnosis/{m}/diagnosis.json" for m in MODELS],
+        *[f"results/data/{r}_acc.csv" for r in LOADED_RECORDS],
     ]

@@ -1,4 +1,5 @@
-# Raw recordings: regenerate from the seed (bit-for-bit check), verify checksums, convert volts to m/s^2.
+# Raw recordings: regenerate from the seed (bit-for-bit check), verify checksums, convert volts to m/s^2
+# (and, for the loaded records, the voltage channel to load volts).
 
 
 rule regenerate_raw_data:
@@ -31,7 +32,7 @@ rule check_raw_reproduced:
 rule verify_checksums:
     input:
         sums=config["data"]["checksums"],
-        files=[f for r in RECORDS for f in raw_files(r).values()]
+        files=[f for r in RECORDS + LOADED_RECORDS for f in raw_files(r).values()]
         + [f"{RAW}/static_friction.csv", f"{RAW}/static_friction.json"],
     output:
         "results/checks/raw_checksums.txt",
@@ -50,10 +51,16 @@ rule convert:
     output:
         "results/data/{record}_acc.csv",
     wildcard_constraints:
-        record="|".join(RECORDS),
+        record="|".join(RECORDS + LOADED_RECORDS),
     log:
         "logs/convert_{record}.log",
     conda:
         ENV
     script:
         "../scripts/convert.py"
+
+
+rule loaded_data:
+    """The loaded records converted: time, base_acc, rel_acc, mass_acc, voltage (V)."""
+    input:
+        expand("results/data/{record}_acc.csv", record=LOADED_RECORDS),

@@ -1,4 +1,5 @@
-"""Rule convert: raw DAQ voltages -> accelerations (m/s^2) and z'' = x'' - y''."""
+"""Rule convert: raw DAQ voltages -> accelerations (m/s^2) and z'' = x'' - y''; a loaded
+record's voltage channel -> the load voltage (V), column ``voltage``."""
 
 from harvester.data.daq import read_raw_record, to_accelerations, write_recording
 from harvester.runlog import rule_log

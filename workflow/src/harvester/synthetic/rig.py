@@ -4,6 +4,8 @@ Green et al. (2015) did not publish their recordings, so this module plays the t
 their Figure 2: a shaker, the device of eq. (1) with a friction law richer than the models
 identified later, a rocking mode of the mass, two DC-coupled MEMS accelerometers and a DAQ.
 It is deliberately independent of the identification code (``simulate.py``, ``physics.py``).
+Its electrical half (generator, star load, voltmeter; the loaded records) is
+``harvester.synthetic.electrical``, which reuses this module's excitation, sensors and DAQ.
 
 Device, eq. (1), z = x - y positive up:
 
@@ -347,43 +349,104 @@ def record_seed(rig: Mapping[str, Any], name: str) -> int:
     return int(rig["seed"]) + int(rig["records"][name]["seed_offset"])
 
 
+@dataclass(frozen=True)
+class RecordGrid:
+    """Sample counts of a record: ``n_out`` DAQ samples at ``fs_out`` (Hz), simulated at
+    ``oversample`` x that rate with ``half`` internal samples of margin either side for the
+    anti-alias filter (the rig at rest before t = 0)."""
+
+    fs_out: float
+    oversample: int
+    n_out: int
+
+    @property
+    def fs(self) -> float:
+        """Internal simulation rate (Hz)."""
+        return self.fs_out * self.oversample
+
+    @property
+    def half(self) -> int:
+        return AA_HALF_OUTPUT_SAMPLES * self.oversample
+
+    @property
+    def n_rec(self) -> int:
+        return self.n_out * self.oversample
+
+    @property
+    def at(self) -> slice:
+        """Internal samples at the output instants."""
+        return slice(self.half, self.half + self.n_rec, self.oversample)
+
+
+def record_grid(rig: Mapping[str, Any], duration_s: float) -> RecordGrid:
+    """The sample grid of a ``duration_s`` record with the config's DAQ."""
+    daq = rig["daq"]
+    fs_out = float(daq["sampling_rate_hz"])
+    return RecordGrid(fs_out, int(daq["oversample"]), int(round(duration_s * fs_out)))
+
+
+def record_streams(seed: int, n: int = 4) -> list[np.random.Generator]:
+    """Independent random streams of a record: excitation, base sensor, mass sensor, ball
+    pass, then (n > 4) any the record adds; the first four do not depend on n."""
+    return [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(n)]
+
+
+def shaker_acceleration(rig: Mapping[str, Any], grid: RecordGrid,
+                        rng: np.random.Generator) -> Array:
+    """y'' (m/s^2) on the internal grid: zero for ``half`` samples, then the excitation."""
+    exc = rig["excitation"]
+    y_dd = np.zeros(grid.half + grid.n_rec + grid.half)  # rig at rest before t = 0
+    y_dd[grid.half:] = base_excitation(grid.n_rec + grid.half, grid.fs, float(exc["cutoff_hz"]),
+                                       int(exc["order"]), float(exc["peak_m_s2"]), rng,
+                                       n_scale=grid.n_rec)
+    return y_dd
+
+
+def adc(rig: Mapping[str, Any], grid: RecordGrid, volts: Array) -> Array:
+    """The DAQ: anti-alias filter, decimation to the output rate, 16-bit quantisation."""
+    daq = rig["daq"]
+    bits, range_V = int(daq["bits"]), (float(daq["range_V"][0]), float(daq["range_V"][1]))
+    return quantise(decimate(volts, grid.oversample, grid.n_out), bits, range_V)
+
+
+def accelerometer_channels(rig: Mapping[str, Any], grid: RecordGrid, y_dd: Array,
+                           mass_terms: tuple[Array, ...], rng_base: np.random.Generator,
+                           rng_mass: np.random.Generator) -> tuple[Array, Array]:
+    """DAQ voltages ai0 (shaker accelerometer) and ai1 (mass accelerometer).
+
+    The mass accelerometer reads y'' plus ``mass_terms`` (z'', the rocking mode), added in
+    that order; each sensor adds its own white noise at the internal rate.
+    """
+    sens = rig["sensors"]
+    sd = noise_rms_internal(float(sens["noise_m_s2"]), grid.oversample)
+    base = y_dd + sd * rng_base.standard_normal(y_dd.size)
+    mass = y_dd
+    for term in mass_terms:
+        mass = mass + term
+    mass = mass + sd * rng_mass.standard_normal(y_dd.size)
+    return adc(rig, grid, sensor_volts(base, sens)), adc(rig, grid, sensor_volts(mass, sens))
+
+
 def simulate_record(rig: Mapping[str, Any], name: str,
                     duration_s: float | None = None) -> RecordSimulation:
     """Run the rig for record ``name`` from rest; ``duration_s`` overrides the config's length."""
-    daq, exc, sens = rig["daq"], rig["excitation"], rig["sensors"]
-    fs_out = float(daq["sampling_rate_hz"])
-    os_ = int(daq["oversample"])
-    fs = fs_out * os_
     duration = float(rig["records"][name]["duration_s"] if duration_s is None else duration_s)
-    n_out = int(round(duration * fs_out))
-    half = AA_HALF_OUTPUT_SAMPLES * os_
-    n_rec = n_out * os_
+    grid = record_grid(rig, duration)
     seed = record_seed(rig, name)
-    rng_exc, rng_base, rng_mass, rng_ball = (np.random.default_rng(s)
-                                             for s in np.random.SeedSequence(seed).spawn(4))
+    rng_exc, rng_base, rng_mass, rng_ball = record_streams(seed)
 
-    y_dd = np.zeros(half + n_rec + half)  # rig at rest before t = 0
-    y_dd[half:] = base_excitation(n_rec + half, fs, float(exc["cutoff_hz"]), int(exc["order"]),
-                                  float(exc["peak_m_s2"]), rng_exc, n_scale=n_rec)
+    y_dd = shaker_acceleration(rig, grid, rng_exc)
     dev = Device.from_config(rig)
-    motion = simulate_motion(y_dd, fs, dev)
-    rock = rocking_acceleration(motion.friction, fs, dev.M, rig["rocking"], motion.v, rng_ball)
-    sd = noise_rms_internal(float(sens["noise_m_s2"]), os_)
-    base = y_dd + sd * rng_base.standard_normal(y_dd.size)
-    mass = y_dd + motion.acc + rock + sd * rng_mass.standard_normal(y_dd.size)
-
-    bits, range_V = int(daq["bits"]), (float(daq["range_V"][0]), float(daq["range_V"][1]))
-
-    def channel(acc: Array) -> Array:
-        return quantise(decimate(sensor_volts(acc, sens), os_, n_out), bits, range_V)
-
-    at = slice(half, half + n_rec, os_)
+    motion = simulate_motion(y_dd, grid.fs, dev)
+    rock = rocking_acceleration(motion.friction, grid.fs, dev.M, rig["rocking"], motion.v,
+                                rng_ball)
+    ai0, ai1 = accelerometer_channels(rig, grid, y_dd, (motion.acc, rock), rng_base, rng_mass)
+    os_, n_out, at = grid.oversample, grid.n_out, grid.at
     truth = {"base_acc": decimate(y_dd, os_, n_out), "rel_acc": decimate(motion.acc, os_, n_out),
              "rocking": decimate(rock, os_, n_out), "z": motion.z[at], "v": motion.v[at],
              "stuck": motion.stuck[at]}
-    return RecordSimulation(name=name, seed=seed, sampling_rate_hz=fs_out,
-                            time=np.arange(n_out) / fs_out, ai0=channel(base), ai1=channel(mass),
-                            truth=truth)
+    return RecordSimulation(name=name, seed=seed, sampling_rate_hz=grid.fs_out,
+                            time=np.arange(n_out) / grid.fs_out, ai0=ai0, ai1=ai1, truth=truth)
 
 
 # --------------------------------------------------------------------------- static friction test
