@@ -73,8 +73,9 @@ log = logging.getLogger("harvester.diagnosis")
 
 #: A chain whose log evidence is this far below the best one missed the posterior's mode.
 MISSED_MODE_NATS = 5.0
-#: Smallest Monte Carlo standard error assumed for a pooled log evidence (nats).
-MIN_SE = 0.5
+#: Smallest Monte Carlo standard error assumed for a pooled log evidence (nats): two chains'
+#: scatter is a poor estimate of it, and the chains may share a bias their errors miss.
+MIN_SE = 0.25
 #: Smallest standard error assumed for a bridge-sampling log evidence (nats).
 BRIDGE_MIN_SE = 0.1
 
@@ -94,6 +95,13 @@ class ConfirmSettings:
 
     reference: a candidate with a start shape tempers from :func:`candidate_reference` (False:
     from the prior, as the baseline and every other candidate do).
+
+    mcmc_steps .. max_mcmc_steps, correlation_threshold: the kernel's moves per stage
+    (``harvester.inference.tmcmc``: until the population decorrelates).
+
+    agreement_nats, enlargements: the chains of a model must agree within agreement_nats;
+    where they do not, the model is sampled again with twice the particles, at most
+    ``enlargements`` times, and the fit says so (``ModelFit.enlarged``).
     """
 
     particles: int = 300
@@ -102,6 +110,10 @@ class ConfirmSettings:
     proposal_scale: float = 0.8
     target_cov: float = 1.0
     mcmc_steps: int = 3
+    max_mcmc_steps: int | None = 30
+    correlation_threshold: float = 0.1
+    agreement_nats: float = 1.0
+    enlargements: int = 2
     alpha: float = 0.05
     mc_sigmas: float = 2.0
     indistinguishable_nats: float = 2.0
@@ -111,7 +123,9 @@ class ConfirmSettings:
     def tmcmc(self, offset: int = 0) -> TMCMCSettings:
         return TMCMCSettings(particles=self.particles, chains=self.chains,
                              seed=self.seed + offset, proposal_scale=self.proposal_scale,
-                             target_cov=self.target_cov, mcmc_steps=self.mcmc_steps)
+                             target_cov=self.target_cov, mcmc_steps=self.mcmc_steps,
+                             max_mcmc_steps=self.max_mcmc_steps,
+                             correlation_threshold=self.correlation_threshold)
 
     @property
     def base_threshold(self) -> float:
@@ -131,6 +145,8 @@ class ModelFit:
     bridge: BridgeEstimate | None = None
     reference: Reference | None = None
     restarted: bool = False  # the reference start collapsed; sampled again from the prior
+    #: (particles, spread of the chains' log evidences) of each run that was enlarged
+    enlarged: list[tuple[int, float]] = field(default_factory=list)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -155,15 +171,18 @@ class ModelFit:
 
     @property
     def tmcmc_log_evidence_se(self) -> float:
-        """Monte Carlo standard error of the pooled log evidence, from the chains that found
-        the posterior's main mode (within MISSED_MODE_NATS of the best chain); a chain far
-        below missed it, which lowers the pooled value by at most log(chains), and is counted
-        in ``missed_chains`` rather than as scatter."""
+        """Monte Carlo standard error of the pooled log evidence: the larger of what the
+        chains state (root sum of their squared errors over the number of chains) and their
+        scatter over the root of their number, from the chains that found the posterior's
+        main mode (within MISSED_MODE_NATS of the best chain); a chain far below missed it,
+        which lowers the pooled value by at most log(chains), and is counted in
+        ``missed_chains`` rather than as scatter. At least MIN_SE."""
         c = self.log_evidence_chains
         near = c[c >= c.max() - MISSED_MODE_NATS]
-        if len(near) > 1:
-            return float(max(np.std(near, ddof=1) / np.sqrt(len(near)), MIN_SE))
-        return float(MIN_SE if len(c) > 1 else 0.0)
+        scatter = float(np.std(near, ddof=1) / np.sqrt(len(near))) if len(near) > 1 else 0.0
+        stated = self.stated_se_chains
+        stated_se = float(np.sqrt(np.sum(np.square(stated))) / len(stated)) if stated else 0.0
+        return float(max(scatter, stated_se, MIN_SE if len(c) > 1 else 0.0))
 
     @property
     def missed_chains(self) -> int:
@@ -178,8 +197,25 @@ class ModelFit:
                 "log_evidence_chains": [float(x) for x in self.log_evidence_chains],
                 "chains_missing_the_mode": self.missed_chains,
                 "log_evidence_bridge": self.bridge.to_dict() if self.bridge else None,
+                "log_evidence_se_chains": self.stated_se_chains,
+                "chains_spread": self.chains_spread,
                 "tempered_from": self.reference.describe() if self.reference else None,
-                "restarted_from_prior": self.restarted}
+                "restarted_from_prior": self.restarted,
+                "enlarged_after": [{"particles": n, "chains_spread": s}
+                                   for n, s in self.enlarged]}
+
+    @property
+    def chains_spread(self) -> float:
+        """Largest minus smallest of the chains' log evidences (nats)."""
+        c = self.log_evidence_chains
+        return float(np.max(c) - np.min(c)) if len(c) > 1 else 0.0
+
+    @property
+    def stated_se_chains(self) -> list[float]:
+        """Each chain's own stated standard error of its log evidence (TMCMC's)."""
+        if self.idata is None or "log_evidence_se" not in self.idata.sample_stats:
+            return []
+        return [float(x) for x in self.idata.sample_stats["log_evidence_se"].values]
 
     def summary(self) -> dict[str, dict[str, float]]:
         return {n: {"mean": float(self.samples[:, j].mean()),
@@ -407,20 +443,35 @@ def fit_structure(problem: ChainProblem, structure: ModelStructure,
                   priors: Mapping[str, PriorSpec], settings: ConfirmSettings,
                   seed_offset: int = 0, reference: Reference | None = None) -> ModelFit:
     """TMCMC of ``structure`` on the data, window, chain and tempering of ``problem``
-    (from ``reference`` instead of the prior where given)."""
+    (from ``reference`` instead of the prior where given); sampled again with twice the
+    particles while its chains disagree by more than ``settings.agreement_nats``."""
     p = chain_problem(problem, problem.temper, problem.lowpass_hz, problem.filter_order,
                       structure=structure)
-    idata = identify(p, priors, settings.tmcmc(seed_offset), reference)
-    samples = posterior_theta(idata)
-    ev = log_evidence(idata)
     used = priors_for(p, priors)
+    enlarged: list[tuple[int, float]] = []
+    run = settings
+    for attempt in range(settings.enlargements + 1):
+        idata = identify(p, priors, run.tmcmc(seed_offset + 7919 * attempt), reference)
+        ev = log_evidence(idata)
+        spread = float(np.ptp(ev)) if len(ev) > 1 else 0.0
+        if spread <= settings.agreement_nats or attempt == settings.enlargements:
+            break
+        log.warning("%s: the chains' log evidences differ by %.2f nats (more than %.1f) with "
+                    "%d particles; sampled again with %d", structure.name, spread,
+                    settings.agreement_nats, run.particles, 2 * run.particles)
+        enlarged.append((run.particles, spread))
+        run = replace(run, particles=2 * run.particles)
+    samples = posterior_theta(idata)
     bridge = None
     if settings.bridge:
         bridge = bridge_evidence(p, used, samples, ev, settings.seed + seed_offset)
     log.info("%s: log evidence %s (TMCMC chains, pooled %.2f)%s", structure.name,
              ", ".join(f"{e:.2f}" for e in ev), pooled_log_evidence(ev),
              f"; bridge sampling {bridge.log_evidence:.2f} +- {bridge.se:.2f}" if bridge else "")
-    return ModelFit(structure, p, samples, ev, idata, used, bridge, reference)
+    if spread > settings.agreement_nats:
+        log.warning("%s: the chains still differ by %.2f nats with %d particles", structure.name,
+                    spread, run.particles)
+    return ModelFit(structure, p, samples, ev, idata, used, bridge, reference, enlarged=enlarged)
 
 
 def bridge_evidence(problem: ChainProblem, priors: Mapping[str, PriorSpec],
@@ -443,6 +494,31 @@ def bridge_evidence(problem: ChainProblem, priors: Mapping[str, PriorSpec],
         return None
 
 
+def candidate_fit(baseline: ModelFit, effect: str, priors: Mapping[str, PriorSpec],
+                  settings: ConfirmSettings, scale: MotionScale,
+                  detection: Detection | None = None, seed_offset: int = 0) -> ModelFit:
+    """The baseline with one more term, sampled by TMCMC: its priors (the candidate's
+    scaled to this device, ``priors`` winning), its particles (:func:`candidate_particles`)
+    and its start (:func:`candidate_reference`, sampled again from the prior if that
+    population collapsed)."""
+    structure = baseline.structure.with_term(effect)
+    specs = {**candidate_priors(effect, scale, baseline.problem.known), **priors}
+    run = replace(settings, particles=candidate_particles(effect, settings.particles))
+    ref = candidate_reference(effect, baseline, detection, priors_for(
+        baseline.problem, specs, baseline.names + term(effect).parameter_names)) \
+        if settings.reference else None
+    log.info("%s: %d particles per chain%s", structure.name, run.particles,
+             "" if ref is None else "; half the particles start from " + describe_start(ref))
+    fit = fit_structure(baseline.problem, structure, specs, run, seed_offset=seed_offset,
+                        reference=ref)
+    if ref is not None and collapsed(fit):
+        log.warning("%s: the population started from the reference collapsed; sampled "
+                    "again from the prior", structure.name)
+        fit = fit_structure(baseline.problem, structure, specs, run, seed_offset=seed_offset)
+        fit.restarted = True
+    return fit
+
+
 def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSpec],
             settings: ConfirmSettings, scale: MotionScale, seed_offset: int = 0,
             detection: Detection | None = None) -> list[CandidateResult]:
@@ -451,23 +527,10 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
     ``Probe.start_shape`` (:func:`candidate_reference`)."""
     results = []
     for i, effect in enumerate(effects):
-        structure = baseline.structure.with_term(effect)
-        specs = {**candidate_priors(effect, scale, baseline.problem.known), **priors}
-        run = replace(settings, particles=candidate_particles(effect, settings.particles))
-        ref = candidate_reference(effect, baseline, detection, priors_for(
-            baseline.problem, specs, baseline.names + term(effect).parameter_names)) \
-            if settings.reference else None
-        log.info("confirming %s (%d of %d, %d particles per chain)%s", structure.name, i + 1,
-                 len(effects), run.particles, "" if ref is None else
-                 "; half the particles start from " + describe_start(ref))
-        fit = fit_structure(baseline.problem, structure, specs, run,
-                            seed_offset=seed_offset + 101 * (i + 1), reference=ref)
-        if ref is not None and collapsed(fit):
-            log.warning("%s: the population started from the reference collapsed; sampled "
-                        "again from the prior", structure.name)
-            fit = fit_structure(baseline.problem, structure, specs, run,
-                                seed_offset=seed_offset + 101 * (i + 1))
-            fit.restarted = True
+        log.info("confirming %s (%d of %d)", baseline.structure.with_term(effect).name, i + 1,
+                 len(effects))
+        fit = candidate_fit(baseline, effect, priors, settings, scale, detection,
+                            seed_offset + 101 * (i + 1))
         delta = fit.log_evidence - baseline.log_evidence
         se = float(np.hypot(fit.log_evidence_se, baseline.log_evidence_se))
         threshold = settings.base_threshold + settings.mc_sigmas * se

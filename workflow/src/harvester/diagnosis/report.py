@@ -209,6 +209,7 @@ def _diagnosis_dict(d) -> dict:
                               "analysis_rate_hz": float(1.0 / (d.time[1] - d.time[0]))},
         "analysis_window_s": list(d.window_s),
         "tmcmc_window_s": list(d.fit_window_s),
+        "traded_away": d.settings.trades(),
         "priors": {k: {"mean": v.mean, "sd": v.sd, "lower": v.lower, "unit": v.unit}
                    for k, v in d.priors.items()},
         "settings": {k: (list(v) if isinstance(v, tuple) else v)

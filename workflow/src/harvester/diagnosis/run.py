@@ -54,15 +54,16 @@ class DiagnosisSettings:
     (``ConfirmSettings``); unexplained_alpha: a detection that no library effect explains
     counts as missing physics only below this p-value (an effect confirmed by evidence
     always does; see ``decide_verdict``); lead_in_s: start of the analysis (the model starts at rest);
-    fit_seconds: most seconds of the recording TMCMC fits (the detection uses all but the
-    holdout); holdout_fraction: share of the recording's end kept unseen when no validation
+    fit_seconds: most seconds of the recording TMCMC fits (None, the default: the whole window
+    the detection analyses, all but the holdout); holdout_fraction: share of the recording's end kept unseen when no validation
     record is given; lowpass_hz: cut-off of the zero-phase low-pass the recording went
     through (None: found from its spectrum, ``spectral.filter_cutoff``); filter_order: its
     order; candidates: library terms considered (None: all); predictive_samples: posterior
     samples simulated for the unseen-data comparison; figures: write figures;
     reference_start: a candidate with a start shape (the secondary mode) tempers from the
     detection's scan and the nested model's posterior (``confirm.candidate_reference``);
-    False: every candidate from its prior.
+    False: every candidate from its prior. enlargements: how often a model whose two chains
+    disagree by more than a nat is sampled again with twice the particles.
     """
 
     particles: int = 300
@@ -78,22 +79,44 @@ class DiagnosisSettings:
     unexplained_alpha: float = 0.001
     window_s: float = 1.0
     lead_in_s: float = 1.0
-    fit_seconds: float = 20.0
+    fit_seconds: float | None = None
     holdout_fraction: float = 0.25
     lowpass_hz: float | None = None
     filter_order: int = 8
     candidates: tuple[str, ...] | None = None
     predictive_samples: int = 100
+    enlargements: int = 2
     figures: bool = True
     reference_start: bool = True
 
     @classmethod
     def fast(cls, **overrides) -> "DiagnosisSettings":
-        """Cheaper settings for grids of many recordings: one round, two candidates, fewer
-        particles and replicates, 10 s fitted (about a quarter of the default's time)."""
+        """Cheaper settings for grids of many recordings only: one round, two candidates,
+        fewer particles and replicates, 10 s fitted (:meth:`trades` says what they give up)."""
         base = dict(particles=150, rounds=1, top=2, bootstrap=300, artifact_components=30,
-                    fit_seconds=10.0, predictive_samples=40)
+                    fit_seconds=10.0, predictive_samples=40, enlargements=1)
         return cls(**{**base, **overrides})
+
+    def trades(self) -> list[str]:
+        """What these settings give up against the defaults, one line each (logged and
+        written to diagnosis.json as ``traded_away``); empty for the defaults."""
+        default = DiagnosisSettings()
+        lines = []
+        if self.fit_seconds is not None:
+            lines.append(f"TMCMC fits at most {self.fit_seconds:g} s of the analysed window "
+                         "(default: all of it, as the detection)")
+        for name, what in (("particles", "TMCMC particles per chain"),
+                           ("chains", "TMCMC chains"),
+                           ("rounds", "rounds of effects added in turn"),
+                           ("top", "candidates sampled per round"),
+                           ("bootstrap", "noise replicates of the detection"),
+                           ("artifact_components", "filter-artefact replicates"),
+                           ("predictive_samples", "posterior samples of the unseen-data fit"),
+                           ("enlargements", "re-runs with more particles where chains disagree")):
+            ours, theirs = getattr(self, name), getattr(default, name)
+            if ours < theirs:
+                lines.append(f"{ours} {what} (default {theirs})")
+        return lines
 
     @classmethod
     def from_config(cls, cfg: Mapping) -> "DiagnosisSettings":
@@ -112,7 +135,7 @@ class DiagnosisSettings:
 
     def confirmation(self) -> ConfirmSettings:
         return ConfirmSettings(particles=self.particles, chains=self.chains, seed=self.seed,
-                               alpha=self.evidence_alpha,
+                               enlargements=self.enlargements, alpha=self.evidence_alpha,
                                indistinguishable_nats=self.indistinguishable_nats,
                                reference=self.reference_start)
 
@@ -176,26 +199,16 @@ def check_recording(df: pd.DataFrame, source: str = "<recording>", lead_in_s: fl
 
     It must hold the lead-in, MIN_ANALYSIS_S analysed seconds (plus the held-out share,
     ``holdout_fraction``, 0 when a validation record is given) and 0.5 s of filter end effects.
+    The checks are ``harvester.data.checks``'s (also absurd magnitudes and dead channels).
     """
-    if not isinstance(df, pd.DataFrame):
-        raise DataError(source, "expected a table with columns " + ", ".join(RECORDING_COLUMNS))
-    for c in RECORDING_COLUMNS:
-        if c not in df.columns:
-            raise DataError(source, f"missing column (need {', '.join(RECORDING_COLUMNS)})",
-                            column=c)
-    for c in RECORDING_COLUMNS:
-        x = pd.to_numeric(df[c], errors="coerce").to_numpy(dtype=float)
-        bad = np.flatnonzero(~np.isfinite(x))
-        if bad.size:
-            raise DataError(source, f"not a finite number at row {int(bad[0]) + 1}", column=c)
-    t = df["time"].to_numpy(dtype=float)
-    dt = uniform_step(t, source)
-    need = lead_in_s + MIN_ANALYSIS_S / (1.0 - holdout_fraction) + 0.5
-    if t[-1] - t[0] + dt < need - 1e-9:
-        held = f", {holdout_fraction:.0%} held out" if holdout_fraction > 0 else ""
-        raise DataError(source, f"too short: {t[-1] - t[0] + dt:.2f} s; the diagnosis needs at "
-                        f"least {need:.2f} s ({lead_in_s:g} s lead-in, {MIN_ANALYSIS_S:g} s "
-                        f"analysed{held}, 0.5 s of filter end effects)")
+    from harvester.data.checks import (check_duration, check_frame, check_live_channels,
+                                       check_magnitudes)
+    from harvester.data.recording import RecordingKinds
+    dt = check_frame(df, source, RECORDING_COLUMNS)
+    kinds = RecordingKinds("base_acc", "rel_acc")
+    check_magnitudes(df, kinds, source)
+    check_live_channels(df, kinds, source)
+    check_duration(df, dt, source, lead_in_s, MIN_ANALYSIS_S, holdout_fraction)
     out = df[list(RECORDING_COLUMNS)].astype(float).reset_index(drop=True)
     return out, dt
 
@@ -308,7 +321,8 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
     end = n - int(round(0.5 * fs))
     hold = end if validation is not None else \
         lead + int(round((end - lead) * (1.0 - settings.holdout_fraction)))
-    fit_stop = min(hold, lead + int(round(settings.fit_seconds * fs)))
+    fit_stop = hold if settings.fit_seconds is None else \
+        min(hold, lead + int(round(settings.fit_seconds * fs)))
     t = rec["time"].to_numpy()
     order = settings.filter_order
     f_high = 0.9 * (lowpass or 0.5 * fs)
@@ -316,6 +330,8 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
              "%.1f-%.1f s", source, n * dt, fs,
              f"{lowpass:.1f} Hz" if lowpass else "none found", t[lead], t[hold - 1], t[lead],
              t[fit_stop - 1])
+    for line in settings.trades():
+        log.warning("these settings trade away: %s", line)
 
     raw_det = make_problem(rec, base, known, window=(lead, hold))
     raw_fit = make_problem(rec, base, known, window=(lead, fit_stop))
@@ -518,6 +534,7 @@ def diagnose_study(recording_df: pd.DataFrame, baseline: str, known: Mapping[str
             min(len(rec), lead_in + samples + int(round(0.5 * fs)))
         rec = rec.iloc[:stop].reset_index(drop=True)
         settings = replace(settings, lead_in_s=lead_in / fs,
-                           fit_seconds=max(settings.fit_seconds, (stop - lead_in) / fs))
+                           fit_seconds=None if settings.fit_seconds is None else
+                           max(settings.fit_seconds, (stop - lead_in) / fs))
     return diagnose(rec, baseline, known, priors, posterior=posterior, validation=validation_df,
                     settings=settings, out_dir=out_dir, source="training recording")

@@ -55,7 +55,7 @@ def compiled(term_name: str, function: str):
     key = (term_name, function)
     if key not in _compiled:
         fn = getattr(term(term_name), function)
-        _compiled[key] = nb.njit(inline="always", error_model="numpy", cache=True)(fn)
+        _compiled[key] = nb.njit(error_model="numpy", cache=True)(fn)
     return _compiled[key]
 
 
@@ -230,7 +230,7 @@ def source(terms: tuple[str, ...], driver: str) -> str:
         f' driver {driver}. Do not edit."""',
         "import numba as nb", "import numpy as np", "",
         "from harvester.model.codegen import BLOW_UP, compiled", "", *imports, "", "",
-        f'{jit}, inline="always")', _rhs_source(objs, driver), "", "",
+        f'{jit})', _rhs_source(objs, driver), "", "",
         f"{jit}, nogil=True)", _integrate_source(objs, driver)])
 
 

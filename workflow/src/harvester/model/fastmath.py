@@ -59,7 +59,7 @@ def _double(typingctx, i):
     return sig, codegen
 
 
-@nb.njit(inline="always", error_model="numpy", cache=True)
+@nb.njit(error_model="numpy", cache=True)
 def _reduce(x):
     """(t, k, r): x = k ln 2 + r, k = round(x / ln 2) held in t's low bits."""
     x = min(max(x, -_X_MAX), _X_MAX)
@@ -69,7 +69,7 @@ def _reduce(x):
     return t, k, r
 
 
-@nb.njit(inline="always", error_model="numpy", cache=True)
+@nb.njit(error_model="numpy", cache=True)
 def _expm1_reduced(r):
     """exp(r) - 1 for |r| <= ln 2 / 2 (Taylor series to r^13, Horner form)."""
     p = 1.0 / 6227020800.0
@@ -87,13 +87,13 @@ def _expm1_reduced(r):
     return (p * r) * r + r
 
 
-@nb.njit(inline="always", error_model="numpy", cache=True)
+@nb.njit(error_model="numpy", cache=True)
 def _two_to(t):
     """2^k for the k held in the low bits of the shifted t."""
     return _double((_bits(t) << 52) + (1023 << 52))
 
 
-@nb.njit(inline="always", error_model="numpy", cache=True)
+@nb.njit(error_model="numpy", cache=True)
 def expm1(x):
     """exp(x) - 1, accurate for small |x| too."""
     t, k, r = _reduce(x)
@@ -102,14 +102,14 @@ def expm1(x):
     return q if k == 0.0 else s * q + (s - 1.0)
 
 
-@nb.njit(inline="always", error_model="numpy", cache=True)
+@nb.njit(error_model="numpy", cache=True)
 def exp(x):
     """exp(x) (0 below -700, exp(700) above 700)."""
     t, _, r = _reduce(x)
     return _two_to(t) * (1.0 + _expm1_reduced(r))
 
 
-@nb.njit(inline="always", error_model="numpy", cache=True)
+@nb.njit(error_model="numpy", cache=True)
 def tanh(x):
     """tanh(x) = -expm1(-2|x|) / (2 + expm1(-2|x|)), with the sign of x."""
     e = expm1(-2.0 * abs(x))
@@ -117,7 +117,7 @@ def tanh(x):
     return t if x >= 0.0 else -t
 
 
-@nb.njit(inline="always", error_model="numpy", cache=True)
+@nb.njit(error_model="numpy", cache=True)
 def sign(x):
     """-1, 0 or 1 (as a double)."""
     return (x > 0.0) - (x < 0.0) + 0.0
