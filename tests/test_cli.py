@@ -13,7 +13,7 @@ import pytest
 from harvester.cli import main
 from harvester.data.daq import write_recording
 from harvester.diagnosis.confirm import candidate_priors
-from harvester.diagnosis.signatures import MotionScale
+from harvester.model.priors import DeviceScale
 from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
 from harvester.initial.recording import recording_priors
 
@@ -166,7 +166,8 @@ def test_without_a_measured_friction_the_priors_span_the_damping_split():
     specs = recording_priors(df, dict(TABLE1_KNOWN), {"F_c": {"mean": 8.4, "sd": 1.0}})
     assert specs["c_m"].mean < 9.0 and specs["c_m"].sd == 50.0
     # the quadratic-damping candidate's prior keeps a positive scale
-    scale = MotionScale(z=0.01, v=0.05, z_quantiles={0.75: 0.01}, f_high=20.0)
+    scale = DeviceScale(force=5.0, v=0.05, z=0.01, f_high=20.0, M=12.8, m=8.0, k=250.0,
+                        z_quantiles={0.75: 0.01})
     assert candidate_priors("quadratic_damping", scale)["c_quad"].sd > 0.0
 
 

@@ -14,7 +14,6 @@ import pytest
 
 from harvester.diagnosis import DiagnosisSettings, quick_detect
 from harvester.diagnosis.baseline import ChainProblem, chain_problem
-from harvester.diagnosis.confirm import backlash_contact_prior
 from harvester.diagnosis.detect import estimate_temper
 from harvester.diagnosis.rank import rank
 from harvester.diagnosis.spectral import filter_cutoff
@@ -181,18 +180,22 @@ def test_a_fast_sampled_recording_is_resampled_to_its_band_and_diagnosed_alike(f
 
 
 def test_backlash_contact_prior_puts_the_contact_resonance_above_the_band():
+    from dataclasses import replace as dc_replace
+
+    from harvester.model.priors import REFERENCE_DEVICE
+    from harvester.model.terms import term
+    device = dc_replace(REFERENCE_DEVICE, f_high=18.0)
+    spec = term("backlash").parameters[1].prior_on(device)
     known = dict(TABLE1_KNOWN)
-    spec = backlash_contact_prior(18.0, known)
     mu = known["m"] * (known["M"] - known["m"]) / known["M"]
     assert np.sqrt(spec.mean / mu) / (2 * np.pi) == pytest.approx(6 * 18.0)
     assert np.sqrt(spec.lower / mu) / (2 * np.pi) == pytest.approx(4 * 18.0)
-    assert backlash_contact_prior(18.0, {"M": 12.8}) is None
-    # and it costs fewer sub-steps than the library's ball-nut default (1e7 N/m)
+    # and it costs fewer sub-steps than a ball nut's 1e7 N/m
     layout = Layout.of(("backlash",))
     row = {**known, "c_m": 109.5, "gap_backlash": 1e-5}
     cost = [substeps(layout, np.array([[{**row, "k_backlash": k}[n]
                                         for n in layout.parameter_names]]), 1 / 256.0)[0]
-            for k in (spec.mean, default_prior("k_backlash").mean)]
+            for k in (spec.mean, 1e7)]
     assert cost[0] < cost[1] / 2
 
 
@@ -218,29 +221,29 @@ def test_the_dissipative_force_is_the_power_the_base_puts_in():
 
 
 def test_candidate_priors_follow_the_device_from_the_papers_rig():
-    """On the paper's rig's scales the library's priors are kept; on a device with 4x the
-    dissipative force, 3x the velocity and twice M and k they follow the device."""
-    from harvester.diagnosis.confirm import REFERENCE_SCALE, candidate_priors
-    from harvester.diagnosis.signatures import MotionScale
+    """On the reference device's scales a term's priors are its defaults; on a device with 4x
+    the dissipative force, 3x the velocity and twice M and k they follow the device."""
+    from dataclasses import replace as dc_replace
 
-    ref = REFERENCE_SCALE
-    rig = MotionScale(z=0.01, v=ref["v"], z_quantiles={0.75: 0.01}, f_high=20.0,
-                      force=ref["force"])
-    known = {"M": ref["M"], "m": 8.0, "k": ref["k"]}
+    from harvester.diagnosis.confirm import candidate_priors
+    from harvester.model.priors import REFERENCE_DEVICE
+
+    rig = REFERENCE_DEVICE
     for effect, name in (("coulomb_friction", "F_coulomb"), ("stribeck_friction", "v_stribeck"),
                          ("inertia_error", "dM"), ("end_stop", "k_stop")):
-        assert candidate_priors(effect, rig, known)[name] == default_prior(name)
-    other = MotionScale(z=0.01, v=3 * ref["v"], z_quantiles={0.75: 0.01}, f_high=20.0,
-                        force=4 * ref["force"])
-    known2 = {"M": 2 * ref["M"], "m": 8.0, "k": 2 * ref["k"]}
+        assert candidate_priors(effect, rig)[name] == default_prior(name)
+    other = dc_replace(rig, v=3 * rig.v, force=4 * rig.force, M=2 * rig.M, k=2 * rig.k)
     for effect, name, ratio in (("coulomb_friction", "F_coulomb", 4.0),
                                 ("stribeck_friction", "F_stribeck", 4.0),
                                 ("stribeck_friction", "v_stribeck", 3.0),
                                 ("tanh_friction", "beta", 1.0 / 3.0),
                                 ("hysteresis", "F_hyst", 4.0),
                                 ("inertia_error", "dM", 2.0), ("end_stop", "k_stop", 2.0)):
-        a, b = candidate_priors(effect, rig, known)[name], candidate_priors(effect, other, known2)[name]
-        assert (b.mean, b.sd) == pytest.approx((a.mean * ratio, a.sd * ratio)), (effect, name)
-    quad = candidate_priors("quadratic_damping", other, known2)["c_quad"]
-    assert quad.sd * other.v**2 == pytest.approx(4 * candidate_priors(
-        "quadratic_damping", rig, known)["c_quad"].sd * rig.v**2)
+        a, b = candidate_priors(effect, rig)[name], candidate_priors(effect, other)[name]
+        c = a.scaled(ratio)
+        assert b.family == c.family
+        assert (b.mean, b.sd, b.lower, b.upper) == pytest.approx(
+            (c.mean, c.sd, c.lower, c.upper), rel=1e-12), (effect, name)
+    quad = candidate_priors("quadratic_damping", other)["c_quad"]
+    assert quad.upper * other.v**2 == pytest.approx(
+        4 * candidate_priors("quadratic_damping", rig)["c_quad"].upper * rig.v**2)

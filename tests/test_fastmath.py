@@ -15,6 +15,8 @@ def _apply(kind, x):
             out[i] = fm.exp(x[i])
         elif kind == 1:
             out[i] = fm.expm1(x[i])
+        elif kind == 3:
+            out[i] = fm.log(x[i])
         else:
             out[i] = fm.tanh(x[i])
     return out
@@ -34,6 +36,15 @@ def test_within_a_few_ulp_of_the_c_library(kind, reference, ulps):
     ours, ref = _apply(kind, x), reference(x)
     ulp = np.spacing(np.abs(ref))
     assert np.all(np.abs(ours - ref) <= ulps * ulp + 1e-300)
+
+
+def test_log_within_a_few_ulp_and_vectorised_loop():
+    rng = np.random.default_rng(4)
+    x = np.concatenate([np.exp(rng.uniform(-690, 690, 40000)), rng.uniform(0.5, 2.0, 20000),
+                        [1.0, 2.0, 0.5, np.sqrt(2.0), 1e-300, 1e300]])
+    ours, ref = _apply(3, x), np.log(x)
+    assert np.all(np.abs(ours - ref) <= 2 * np.spacing(np.abs(ref)) + 1e-300)
+    assert _apply(3, np.array([0.0]))[0] == pytest.approx(np.log(1e-300))
 
 
 def test_tanh_keeps_its_sign_and_saturates():

@@ -7,7 +7,10 @@ import pytest
 
 from harvester.model import codegen
 from harvester.model.structures import Layout
+from harvester.model.priors import Prior
 from harvester.model.terms import BASE_PARAMETERS, TERMS, Parameter, check_term, register
+
+GOOD = Prior("loguniform", 0.1, 1.0, why="a reason")
 
 
 def test_every_term_is_complete_and_in_a_file_named_for_it():
@@ -27,9 +30,12 @@ def test_parameter_names_are_unique_across_the_library():
     (dict(equation=""), "no equation"),
     (dict(description=""), "no description"),
     (dict(n_states=1), "state_rates"),
-    (dict(parameters=(Parameter("F_x", "", 1.0, 1.0),)), "unit"),
-    (dict(parameters=(Parameter("_F", "N", 1.0, 1.0, 0.0, "d"),)), "identifiers"),
-    (dict(parameters=(Parameter("F_x", "N", 1.0, 0.0, 0.0, "d"),)), "prior sd"),
+    (dict(probe=None), "probe"),
+    (dict(parameters=(Parameter("F_x", "", GOOD, "d"),)), "unit"),
+    (dict(parameters=(Parameter("_F", "N", GOOD, "d"),)), "identifiers"),
+    (dict(parameters=(Parameter("F_x", "N", Prior("loguniform", 0.1, 1.0), "d"),)), "why"),
+    (dict(parameters=(Parameter("F_x", "N", Prior("loguniform", 1.0, 0.1, why="r"), "d"),)),
+     "lower < upper"),
 ])
 def test_registry_refuses_an_incomplete_term(change, message):
     bad = replace(TERMS["coulomb_friction"], name="bad_term", **change)

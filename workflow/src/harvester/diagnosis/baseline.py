@@ -161,49 +161,104 @@ class PointFit:
         return np.column_stack([draws, np.full(n, self.theta[-1])])
 
 
-def _prior_arrays(problem: Problem, priors: Mapping[str, PriorSpec]):
-    names = problem.structure.free_parameters
-    specs = priors_for(problem, priors, names)
-    mu = np.array([specs[n].mean for n in names])
-    sd = np.array([specs[n].sd for n in names])
-    lower = np.array([specs[n].lower for n in names])
-    return mu, sd, lower
+@dataclass(frozen=True)
+class PriorCoordinates:
+    """Each free parameter in its prior's coordinate, u = (g(theta) - centre) / scale, g the
+    identity (normal priors) or ln (log-normal, log-uniform): the MAP fit and its Laplace
+    approximation work in u, where a normal or log-normal prior is a standard normal and a
+    log-uniform one is flat between its bounds (``harvester.model.priors``)."""
+
+    specs: tuple[PriorSpec, ...]
+
+    @classmethod
+    def of(cls, problem: Problem, priors: Mapping[str, PriorSpec]) -> "PriorCoordinates":
+        names = problem.structure.free_parameters
+        specs = priors_for(problem, priors, names)
+        return cls(tuple(specs[n] for n in names))
+
+    @property
+    def center(self) -> np.ndarray:
+        return np.array([s.center for s in self.specs])
+
+    @property
+    def scale(self) -> np.ndarray:
+        return np.array([s.scale for s in self.specs])
+
+    @property
+    def penalty(self) -> np.ndarray:
+        """1 where the prior is a Gaussian in u, 0 where it is flat."""
+        return np.array([0.0 if s.is_flat else 1.0 for s in self.specs])
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        low = np.array([(s.bounds[0] - s.center) / s.scale for s in self.specs])
+        high = np.array([(s.bounds[1] - s.center) / s.scale for s in self.specs])
+        return low, high
+
+    def theta(self, u: np.ndarray) -> np.ndarray:
+        """Parameter values of rows of u."""
+        g = self.center + np.atleast_2d(u) * self.scale
+        return np.column_stack([s.from_coordinate(g[:, j]) for j, s in enumerate(self.specs)])
+
+    def dtheta_du(self, u: np.ndarray) -> np.ndarray:
+        """d theta / d u at one u (a vector)."""
+        theta = self.theta(u)[0]
+        return np.array([th * s.scale if s.is_log else s.scale
+                         for th, s in zip(theta, self.specs)])
 
 
 def fit_map(problem: ChainProblem, priors: Mapping[str, PriorSpec], n_starts: int = 48,
             seed: int = 0) -> PointFit:
     """Posterior mode of the free physical parameters, sigma profiled (sigma = RMS residual).
 
-    Minimises lambda n/2 log(sum r^2) + 1/2 sum ((theta - mu)/sd)^2 over theta >= lower
-    (truncated Gaussian priors, lambda = ``problem.temper``, r through the measurement chain),
-    by trust-region least squares in prior-scaled coordinates, started from the best of
-    ``n_starts`` prior draws (and the prior mean) evaluated in one batched simulation.
-    Jacobians by forward differences, one batched simulation each.
+    Minimises lambda n/2 log(sum r^2) + 1/2 sum_j w_j u_j^2 over u within the priors' bounds
+    (u the prior coordinates, :class:`PriorCoordinates`; w_j = 0 for a flat prior; lambda =
+    ``problem.temper``, r through the measurement chain), by trust-region least squares,
+    started from the best of ``n_starts`` prior draws (and the prior's centre) evaluated in one
+    batched simulation. Jacobians by forward differences, one batched simulation each.
     """
-    mu, sd, lower = _prior_arrays(problem, priors)
-    temper = problem.temper
-    p = len(mu)
-    n = problem.n_data
+    coords = PriorCoordinates.of(problem, priors)
+    w = coords.penalty
+    temper, n = problem.temper, problem.n_data
     count = [0]
 
     def resid_u(us: np.ndarray) -> np.ndarray:
-        theta = np.column_stack([mu + us * sd, np.ones(len(us))])
-        count[0] += len(us)
+        theta = np.column_stack([coords.theta(us), np.ones(len(np.atleast_2d(us)))])
+        count[0] += len(theta)
         return problem.residuals(theta)
 
     def objective_rows(us: np.ndarray) -> np.ndarray:
         r = resid_u(us)
         with np.errstate(invalid="ignore"):
-            val = 0.5 * temper * n * np.log(np.sum(r * r, axis=1)) + 0.5 * np.sum(us * us, axis=1)
+            val = 0.5 * temper * n * np.log(np.sum(r * r, axis=1)) + 0.5 * np.sum(w * us * us,
+                                                                                  axis=1)
         return np.where(np.isfinite(val), val, np.inf)
 
-    u_low = np.where(np.isfinite(lower), (lower - mu) / sd, -np.inf)
-    rng = np.random.default_rng(seed)
-    draws = np.maximum(rng.standard_normal((n_starts, p)), u_low + 1e-6)
-    candidates = np.vstack([np.maximum(np.zeros(p), u_low + 1e-6), draws])
-    u0 = candidates[int(np.argmin(objective_rows(candidates)))]
+    u0 = _best_start(coords, n_starts, seed, objective_rows)
+    u = _least_squares(resid_u, u0, coords, temper, n)
+    return _point_fit(problem, coords, u, resid_u, temper, n, count)
 
-    # least-squares form [sqrt(lambda) r / s ; u], s the RMS residual where sigma was profiled
+
+def _best_start(coords: PriorCoordinates, n_starts: int, seed: int, objective) -> np.ndarray:
+    """The best of the prior's centre and ``n_starts`` draws from the priors (in u)."""
+    low, high = coords.bounds()
+    rng = np.random.default_rng(seed)
+    p = len(low)
+    flat = coords.penalty == 0.0
+    draws = rng.standard_normal((n_starts, p))
+    draws[:, flat] = rng.uniform(np.maximum(low, -3.0), np.minimum(high, 3.0),
+                                 (n_starts, p))[:, flat]
+    inside = lambda x: np.clip(x, low + 1e-6, high - 1e-6)  # noqa: E731
+    candidates = np.vstack([inside(np.zeros(p)), inside(draws)])
+    return candidates[int(np.argmin(objective(candidates)))]
+
+
+def _least_squares(resid_u, u0: np.ndarray, coords: PriorCoordinates, temper: float,
+                   n: int) -> np.ndarray:
+    """Trust-region least squares on [sqrt(lambda) r / s ; sqrt(w) u], s the RMS residual at
+    the start of each solve (sigma profiled), re-profiled between solves."""
+    w = np.sqrt(coords.penalty)
+    low, high = coords.bounds()
+    p = len(u0)
     state: dict[str, float] = {}
 
     def residuals(u: np.ndarray) -> np.ndarray:
@@ -211,32 +266,43 @@ def fit_map(problem: ChainProblem, priors: Mapping[str, PriorSpec], n_starts: in
         if not np.all(np.isfinite(r)):
             return np.full(n + p, 1e6)
         s = state.setdefault("s", float(np.sqrt(np.mean(r * r))))
-        return np.concatenate([np.sqrt(temper) * r / s, u])
+        return np.concatenate([np.sqrt(temper) * r / s, w * u])
 
     def jacobian(u: np.ndarray) -> np.ndarray:
         h = 1e-4 * np.maximum(1.0, np.abs(u))
         r = resid_u(np.vstack([u, u + np.diag(h)]))
         jr = (r[1:] - r[0]).T / h * np.sqrt(temper) / state["s"]
         jr[~np.isfinite(jr)] = 0.0
-        return np.vstack([jr, np.eye(p)])
+        return np.vstack([jr, np.diag(w)])
 
     u = u0
     for _ in range(4):  # re-profile sigma between solves
         state.clear()
         residuals(u)
-        sol = optimize.least_squares(residuals, u, jac=jacobian, bounds=(u_low, np.inf),
+        sol = optimize.least_squares(residuals, u, jac=jacobian, bounds=(low, high),
                                      method="trf", x_scale=1.0, max_nfev=60)
         moved = np.max(np.abs(sol.x - u))
         u = sol.x
         if moved < 1e-4:
             break
-    theta_phys = mu + u * sd
+    return u
+
+
+def _point_fit(problem: ChainProblem, coords: PriorCoordinates, u: np.ndarray, resid_u,
+               temper: float, n: int, count: list[int]) -> PointFit:
+    """The MAP's PointFit with its Laplace covariance (lambda J^T J / sigma^2 + diag(w))^-1 in
+    u (J = d model / d u), mapped to the parameters (a tiny floor keeps flat, uninformed
+    directions finite)."""
+    theta_phys = coords.theta(u)[0]
     r = resid_u(u[None, :])[0]
     sigma = float(np.sqrt(np.mean(r * r)))
-    # Laplace covariance: (lambda J^T J / sigma^2 + diag(1 / sd^2))^-1, J = d model / d theta
-    state["s"] = sigma
-    jt = -jacobian(u)[:n] * sigma / np.sqrt(temper) / sd[None, :]
-    cov = np.linalg.inv(temper * jt.T @ jt / sigma**2 + np.diag(1.0 / sd**2))
+    h = 1e-4 * np.maximum(1.0, np.abs(u))
+    rows = resid_u(np.vstack([u, u + np.diag(h)]))
+    jm = -(rows[1:] - rows[0]).T / h  # d model / d u, (n, p)
+    jm[~np.isfinite(jm)] = 0.0
+    prec = temper * jm.T @ jm / sigma**2 + np.diag(np.maximum(coords.penalty, 1e-6))
+    d = coords.dtheta_du(u)
+    cov = np.linalg.inv(prec) * np.outer(d, d)
     log.info("MAP of %s: %s, sigma = %.4g (%d simulations)", problem.structure.name,
              ", ".join(f"{nm}={v:.4g}" for nm, v in zip(problem.structure.free_parameters,
                                                         theta_phys)), sigma, count[0])

@@ -15,20 +15,12 @@ whose standard error is its own; TMCMC's chains alone scatter by several nats at
 diagnosis's particle counts. Candidates whose evidences lie within ``indistinguishable_nats``
 (or the Monte Carlo error) of the best accepted one are reported as indistinguishable.
 
-Priors of the added terms: the library's (``physics.py``), set for the paper's rig, taken to
-another device by the ratio of its scales to the rig's (``candidate_priors``): forces by the
-damping the motion shows (``signatures.dissipative_force``, the power the base puts in over
-the RMS velocity), velocities by the RMS velocity, masses by M, the stop's contact stiffness
-by k. Where the library's default has no such ratio: the end stop's clearance and the cubic
-stiffness are scaled by the baseline's displacement (and k), quadratic damping by the
-dissipative force over the squared RMS velocity, the backlash's contact
-stiffness and the secondary mode's frequency by the analysed band
-(:func:`backlash_contact_prior`), and the pre-sliding (hysteresis) force is kept above 0.2 N
-(on the paper's rig; scaled as forces are), below which the Dahl law is too stiff to
-integrate in minutes, and the bristle stiffness's prior (2 +- 2 kN/m on the paper's rig,
-pre-sliding displacements of about 0.1-10 mm at those forces) leaves out
-the stiff tail (k_hyst / F_hyst > 1e5 /m) that made one sampled candidate cost minutes in the
-grid. Priors given by the caller always win.
+Priors of the added terms: each parameter's prior as its term file states it, in the
+device's own scales (``harvester.model.priors``: the damping force the motion shows, its RMS
+velocity and displacement, M, k, the analysed band), read on this device's scales
+(``signatures.motion_scale``). Scale parameters span their physically plausible decades
+(log-uniform), with the reasoning beside each; the evidence pays for that breadth through
+the Occam factor. Priors given by the caller always win.
 
 Particles. A candidate's TMCMC gets ``particles`` x (its added parameters / 2), at least
 ``particles`` (``candidate_particles``): the secondary mode's four parameters hold a narrow
@@ -57,13 +49,13 @@ import numpy as np
 
 from harvester.diagnosis.baseline import ChainProblem, chain_problem
 from harvester.diagnosis.detect import Detection
-from harvester.diagnosis.signatures import PROBES, MotionScale
+from harvester.model.priors import DeviceScale
 from harvester.inference.evidence import BridgeEstimate, chains_bridge_log_evidence, log_target
 from harvester.inference.identify import TMCMCSettings, identify, posterior_theta
 from harvester.model.terms import term
 from harvester.inference.posterior import pooled_log_evidence
 from harvester.inference.priors import PriorSpec
-from harvester.inference.priors import default_prior, priors_for
+from harvester.inference.priors import priors_for
 from harvester.inference.reference import GaussianFactor, Reference, ScanFactor
 from harvester.model.structures import ModelStructure
 from harvester.inference.tmcmc import log_evidence
@@ -248,96 +240,13 @@ class CandidateResult:
                 "added_parameters": {n: summ[n] for n in added if n in summ}}
 
 
-#: The backlash candidate's contact resonance, sqrt(k_backlash / mu) / 2 pi with mu the reduced
-#: mass m J / (m + J), as multiples of the analysed band's upper edge: prior mean and lower bound.
-BACKLASH_CONTACT_BAND = (6.0, 4.0)
-
-
-def backlash_contact_prior(f_high: float, known: Mapping[str, float]) -> PriorSpec | None:
-    """Prior of k_backlash (N/m) whose contact resonance lies 4-6 x above the analysed band.
-
-    Above the band the recorded z'' cannot tell a stiffer contact from this one (the impact's
-    momentum, not its millisecond shape, shows below f_high), while the simulation's cost
-    grows as the resonance: a ball nut's 1e7-1e9 N/m costs 3-30 x more sub-steps for the same
-    evidence. None when M and m are not both known (M > m > 0).
-    """
-    M, m = float(known.get("M", 0.0)), float(known.get("m", 0.0))
-    if not M > m > 0.0:
-        return None
-    mu = m * (M - m) / M
-    k_mean, k_low = (mu * (2.0 * np.pi * r * f_high) ** 2 for r in BACKLASH_CONTACT_BAND)
-    return PriorSpec("k_backlash", k_mean, 0.5 * k_mean, "N/m", k_low)
-
-
-#: The motion the library's default priors were set for: the paper's rig as the study's
-#: virtual rig drives it. Measured on results/data/training_filtered.csv, simulated at
-#: Table 5's tanh posterior and at the linear model's viscous fit: dissipative force scale
-#: (``signatures.dissipative_force``) 7.1 and 7.8 N, RMS velocity 0.012 and 0.011 m/s;
-#: M and k are Table 1's.
-REFERENCE_SCALE = {"force": 7.5, "v": 0.011, "M": 12.8, "k": 250.0}
-
-#: Library parameters whose defaults hold for the paper's rig only, by the scale they follow on
-#: another device: friction-like forces (and the bristle stiffness, a force over a pre-sliding
-#: displacement that does not scale) the dissipative force, the Stribeck velocity the RMS
-#: velocity, beta its inverse, mass errors and modal masses M, the stop's contact stiffness k.
-SCALED_BY = {"F_c": "force", "F_coulomb": "force", "F_stribeck": "force", "F_asym": "force",
-             "F_hyst": "force", "k_hyst": "force", "F_offset": "force", "v_stribeck": "v",
-             "beta": "1/v", "dM": "M", "mass_mode": "M", "k_stop": "k"}
-
-#: Quadratic damping's prior sd as a share of the dissipative force at the RMS velocity:
-#: on the paper's rig 0.5 x Table 4's c_m scale (170 N s/m) x 0.011 m/s = 0.94 N of 7.5 N.
-QUAD_DAMPING_SHARE = 0.125
-
-
-def device_ratios(scale: MotionScale, known: Mapping[str, float] | None = None
-                  ) -> dict[str, float]:
-    """This device's scales over :data:`REFERENCE_SCALE` (1 where one is not known)."""
-    known = known or {}
-    ref = REFERENCE_SCALE
-    r = {"force": (scale.force or ref["force"]) / ref["force"], "v": scale.v / ref["v"],
-         "M": float(known.get("M") or ref["M"]) / ref["M"],
-         "k": float(known.get("k") or ref["k"]) / ref["k"]}
-    r["1/v"] = 1.0 / r["v"]
-    return r
-
-
-def scaled_prior(spec: PriorSpec, ratio: float) -> PriorSpec:
-    """``spec`` with mean, sd and a finite lower bound multiplied by ``ratio``."""
-    lower = spec.lower * ratio if np.isfinite(spec.lower) else spec.lower
-    return PriorSpec(spec.name, spec.mean * ratio, spec.sd * ratio, spec.unit, lower)
-
-
-def candidate_priors(effect: str, scale: MotionScale, known: Mapping[str, float] | None = None
+def candidate_priors(effect: str, scale: DeviceScale, known: Mapping[str, float] | None = None
                      ) -> dict[str, PriorSpec]:
-    """Priors of an added term's parameters: the library's, scaled from the paper's rig to this
-    device (:func:`device_ratios`, :data:`SCALED_BY`), and set from the baseline's motion where
-    no ratio fits (see the module docstring)."""
-    ratio = device_ratios(scale, known)
-    out = {}
-    for p in term(effect).parameters:
-        spec = default_prior(p.name)
-        out[p.name] = scaled_prior(spec, ratio[SCALED_BY[p.name]]) if p.name in SCALED_BY \
-            else spec
-    force = scale.force or REFERENCE_SCALE["force"]
-    if effect == "backlash":
-        contact = backlash_contact_prior(scale.f_high, known or {})
-        if contact is not None:
-            out["k_backlash"] = contact
-    if effect == "end_stop":
-        gap = scale.z_quantiles[0.75]
-        out["gap_stop"] = PriorSpec("gap_stop", gap, gap, "m", 0.0)
-    elif effect == "cubic_stiffness":
-        k = ratio["k"] * REFERENCE_SCALE["k"]
-        out["k_cubic"] = PriorSpec("k_cubic", 0.0, k / scale.z**2, "N/m^3", -np.inf)
-    elif effect == "quadratic_damping":
-        out["c_quad"] = PriorSpec("c_quad", 0.0, QUAD_DAMPING_SHARE * force / scale.v**2,
-                                  "N s^2/m^2", 0.0)
-    elif effect == "unmodelled_mode":
-        out["f_mode"] = PriorSpec("f_mode", 0.5 * scale.f_high, 0.35 * scale.f_high, "Hz", 0.5)
-    elif effect == "hysteresis":
-        out["F_hyst"] = scaled_prior(PriorSpec("F_hyst", 2.0, 2.0, "N", 0.2), ratio["force"])
-        out["k_hyst"] = scaled_prior(PriorSpec("k_hyst", 2e3, 2e3, "N/m", 100.0), ratio["force"])
-    return out
+    """Priors of an added term's parameters on this device: each parameter's prior in the
+    device's scales (its term file, ``harvester.model.priors.Prior``) read on ``scale``.
+    ``known``: accepted for callers that pass the device's known values (``scale`` holds
+    them)."""
+    return {p.name: p.prior_on(scale) for p in term(effect).parameters}
 
 
 def candidate_particles(effect: str, particles: int) -> int:
@@ -389,8 +298,8 @@ def scan_factor(effect: str, detection: Detection | None,
     spacing), weighted by exp(statistic / 2) summed over each value's signatures (the score
     test's likelihood ratio). None where the effect has no start shape or fewer than 3 values
     were scanned."""
-    probe = PROBES.get(effect)
-    if detection is None or probe is None or probe.start_shape is None:
+    probe = term(effect).probe
+    if detection is None or probe.start_shape is None:
         return None
     name = probe.start_shape
     idx = [i for i, sig in enumerate(detection.signatures)
@@ -495,7 +404,7 @@ def bridge_evidence(problem: ChainProblem, priors: Mapping[str, PriorSpec],
 
 
 def candidate_fit(baseline: ModelFit, effect: str, priors: Mapping[str, PriorSpec],
-                  settings: ConfirmSettings, scale: MotionScale,
+                  settings: ConfirmSettings, scale: DeviceScale,
                   detection: Detection | None = None, seed_offset: int = 0) -> ModelFit:
     """The baseline with one more term, sampled by TMCMC: its priors (the candidate's
     scaled to this device, ``priors`` winning), its particles (:func:`candidate_particles`)
@@ -520,7 +429,7 @@ def candidate_fit(baseline: ModelFit, effect: str, priors: Mapping[str, PriorSpe
 
 
 def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSpec],
-            settings: ConfirmSettings, scale: MotionScale, seed_offset: int = 0,
+            settings: ConfirmSettings, scale: DeviceScale, seed_offset: int = 0,
             detection: Detection | None = None) -> list[CandidateResult]:
     """Sample each augmented structure; evidence against the baseline; acceptance.
     ``detection``: the round's detection, whose scans place the start of candidates with a

@@ -80,7 +80,9 @@ class DetectionSettings:
 @dataclass
 class Conflict:
     """Prior-data conflict of one parameter: z of the data's estimate against the prior's
-    prediction of it, its two-sided tail probability, and the flag (``prior_conflicts``)."""
+    prediction of it, its two-sided tail probability, and the flag (``prior_conflicts``); the
+    means and sds are in the prior's coordinate (x, or ln x for log priors); ``at_edge``: the
+    bound of the prior the posterior piles against, if any."""
 
     parameter: str
     prior_mean: float
@@ -90,6 +92,7 @@ class Conflict:
     z: float
     tail_probability: float
     conflict: bool
+    at_edge: str | None = None
 
     def to_dict(self) -> dict:
         return dict(self.__dict__)
@@ -190,17 +193,42 @@ def data_estimate(prior_mean: float, prior_sd: float, post_mean: float, post_sd:
     return float(var * (post_mean / post_sd**2 - prior_mean / prior_sd**2)), float(np.sqrt(var))
 
 
+#: A posterior holding at least this share within EDGE_SHARE of its prior's range from a
+#: bound (in the prior's coordinate) is piled against that edge.
+EDGE_MASS = 0.5
+EDGE_SHARE = 0.05
+
+
+def at_prior_edge(spec: PriorSpec, x: np.ndarray) -> str | None:
+    """'lower' or 'upper' where the posterior samples x pile against that bound of a prior
+    with a finite range (a finding to report: the prior cut off what the data wanted), else
+    None. Priors open on one side are judged on their finite bound, within EDGE_SHARE x 6
+    of their scales."""
+    low, high = spec.bounds
+    if not (np.isfinite(low) or np.isfinite(high)) or len(x) < 2:
+        return None
+    u = spec.to_coordinate(np.asarray(x, dtype=float))
+    width = (high - low) if np.isfinite(low) and np.isfinite(high) else 6.0 * spec.scale
+    for side, bound, near in (("lower", low, u - low), ("upper", high, high - u)):
+        if np.isfinite(bound) and np.mean(near < EDGE_SHARE * width) >= EDGE_MASS:
+            return side
+    return None
+
+
 def prior_conflicts(names: tuple[str, ...], samples: np.ndarray,
                     priors: Mapping[str, PriorSpec], settings: DetectionSettings
                     ) -> list[Conflict]:
     """Prior-data conflict of every physical parameter (sigma excluded).
 
     What the data alone say of a parameter (``data_estimate``) is compared with the prior's
-    prediction of it: z = (m_L - m_0) / sqrt(s_0^2 + s_L^2), N(0, 1) when the prior is right
-    (a Gaussian prior-predictive check; truncation at the lower bound is ignored). A
-    parameter the data barely inform gets s_L large and z small, however far its posterior
-    moved; one the data pin down is judged on its distance in prior sds. Flagged below the
-    family-wise level ``conflict_alpha`` (two-sided).
+    prediction of it, in the prior's own coordinate (x, or ln x for log-normal and
+    log-uniform priors): z = (m_L - m_0) / sqrt(s_0^2 + s_L^2), N(0, 1) when the prior is
+    right (a Gaussian prior-predictive check; a truncation is ignored, a log-uniform prior is
+    taken as the Gaussian of its mean and sd in ln x). A parameter the data barely inform gets
+    s_L large and z small, however far its posterior moved; one the data pin down is judged on
+    its distance in prior sds. Flagged below the family-wise level ``conflict_alpha``
+    (two-sided). A posterior piled against a bound of its prior is reported too
+    (``at_prior_edge``).
     """
     from scipy.stats import norm
 
@@ -211,14 +239,15 @@ def prior_conflicts(names: tuple[str, ...], samples: np.ndarray,
         if name == "sigma":
             continue
         spec = priors.get(name) or default_prior(name)
-        x = samples[:, j]
+        x = spec.to_coordinate(samples[:, j])
         mean = float(np.mean(x))
         sd = float(np.std(x, ddof=1)) if len(x) > 1 else 0.0
-        m_l, s_l = data_estimate(spec.mean, spec.sd, mean, sd)
-        z = 0.0 if not np.isfinite(s_l) else (m_l - spec.mean) / float(np.hypot(spec.sd, s_l))
+        m_l, s_l = data_estimate(spec.center, spec.scale, mean, sd)
+        z = 0.0 if not np.isfinite(s_l) else (m_l - spec.center) / float(np.hypot(spec.scale,
+                                                                                   s_l))
         tail = float(2.0 * norm.sf(abs(z)))
-        out.append(Conflict(name, spec.mean, spec.sd, mean, sd, float(z), tail,
-                            bool(tail < level)))
+        out.append(Conflict(name, spec.center, spec.scale, mean, sd, float(z), tail,
+                            bool(tail < level), at_prior_edge(spec, samples[:, j])))
     return out
 
 

@@ -184,11 +184,9 @@ def added_parameters(diag, path: Path) -> Path | None:
         ax.hist(x, bins=30, density=True, color="0.6")
         spec = fit.priors.get(name)
         if spec is not None:
-            grid = np.linspace(min(x.min(), spec.mean - 2 * spec.sd),
-                               max(x.max(), spec.mean + 2 * spec.sd), 200)
-            ax.plot(grid, spec.distribution().pdf(grid) if np.isfinite(spec.lower) else
-                    np.exp(-0.5 * ((grid - spec.mean) / spec.sd) ** 2) / (spec.sd * 2.5066),
-                    color="k", lw=1, label="prior")
+            lo, hi = spec.distribution().ppf([0.01, 0.99])
+            grid = np.linspace(min(x.min(), lo), max(x.max(), hi), 200)
+            ax.plot(grid, np.exp(spec.logpdf(grid)), color="k", lw=1, label="prior")
             unit = f" ({spec.unit})" if spec.unit else ""
         else:
             unit = ""

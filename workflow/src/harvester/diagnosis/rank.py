@@ -67,8 +67,10 @@ def _prior_offsets(state: BaselineState, priors: Mapping[str, PriorSpec]
     d, s = [], []
     for j, name in enumerate(names):
         spec = priors.get(name) or default_prior(name)
-        d.append(state.samples[:, j].mean() - spec.mean)
-        s.append(spec.sd)
+        # in the parameter's own units: a log prior's centre and its spread there
+        centre = float(spec.from_coordinate(spec.center))
+        d.append(state.samples[:, j].mean() - centre)
+        s.append(spec.sd if not spec.is_log else centre * (np.exp(spec.sd) - 1.0))
     return np.array(d), np.array(s)
 
 

@@ -210,7 +210,8 @@ def _diagnosis_dict(d) -> dict:
         "analysis_window_s": list(d.window_s),
         "tmcmc_window_s": list(d.fit_window_s),
         "traded_away": d.settings.trades(),
-        "priors": {k: {"mean": v.mean, "sd": v.sd, "lower": v.lower, "unit": v.unit}
+        "priors": {k: {"family": v.family, "mean": v.mean, "sd": v.sd, "lower": v.lower,
+                       "upper": v.upper, "unit": v.unit, "described": v.describe()}
                    for k, v in d.priors.items()},
         "settings": {k: (list(v) if isinstance(v, tuple) else v)
                      for k, v in s.__dict__.items()},

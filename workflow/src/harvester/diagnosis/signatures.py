@@ -1,103 +1,43 @@
 """Output signatures of candidate effects: how z''(t) would change if the effect were present.
 
-For a candidate term e of the physics library (``physics.TERMS``) added to the baseline at its
+For a candidate term e of the physics library (``harvester.model.terms``) added to the baseline at its
 posterior mean, the signature is the secant
 
     g_e(t) = (z''(theta, e at strength a) - z''(theta, e switched off)) / a
 
 computed by the batched simulator, so it carries the full (nonlinear) dynamics of the
 baseline: a missing force is seen through the structure's response, not as a force. ``a`` is a
-small probe strength (a force of about 1 N, a mass of 0.1 kg); for effects with a shape
-parameter (clearance of an end stop, Stribeck velocity, frequency of a mode, steepness of
-friction) a small grid of shapes is scanned, scaled to the baseline's own motion (displacement
-and velocity quantiles, passband) so that the grid means the same on any rig.
+small probe strength (a tenth of the damping force, a hundredth of the mass); for effects
+with a shape parameter (clearance of an end stop, Stribeck velocity, frequency of a mode,
+steepness of friction) a small grid of shapes is scanned, scaled to the baseline's own motion
+(displacement and velocity quantiles, passband) so that the grid means the same on any rig.
+Each term's probe is in its own file (``harvester.model.terms.Probe``).
 """
 
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from harvester.diagnosis.baseline import BaselineState
-from harvester.model.structures import Layout
-from harvester.model.terms import TERMS, term
+from harvester.model.priors import REFERENCE_DEVICE, DeviceScale
 from harvester.model.simulate import simulate
+from harvester.model.structures import Layout
+from harvester.model.terms import TERMS, Probe, term
 
 log = logging.getLogger("harvester.diagnosis")
 
 
-@dataclass(frozen=True)
-class MotionScale:
-    """Typical magnitudes of the baseline's simulated motion over the analysis window."""
-
-    z: float  # RMS displacement (m)
-    v: float  # RMS velocity (m/s)
-    z_quantiles: dict[float, float]  # quantiles of |z| (m)
-    f_high: float  # upper edge of the analysed band (Hz)
-    force: float | None = None  # dissipative force scale c_eq v (N), :func:`dissipative_force`
+def probe(name: str) -> Probe:
+    """The term's probe (``harvester.model.terms.Probe``)."""
+    return term(name).probe
 
 
-#: A grid of shape values (dict parameter -> value) from the motion scale.
-ShapeGrid = Callable[[MotionScale], list[dict[str, float]]]
-
-
-@dataclass(frozen=True)
-class Probe:
-    """How to switch on a small amount of one term of the library.
-
-    strength: the parameter whose zero switches the effect off; amount(scale): the probe
-    strength; signed: the strength may be negative (two-sided test); shapes(scale): grid of
-    the term's other parameters (others stay at the library's prior mean); reference:
-    "baseline" (effect off = the baseline itself) or "zero" (the term kept with strength 0,
-    when zero strength still changes the structure, as a backlash coupling does).
-    ``start_shape``: a shape parameter whose posterior is a peak too narrow for a few hundred
-    prior draws to hit (a resonance's frequency): the candidate's TMCMC starts part of its
-    particles where this scan's scores place it (``confirm.scan_factor``).
-    """
-
-    term: str
-    strength: str
-    amount: Callable[[MotionScale], float]
-    signed: bool = False
-    shapes: ShapeGrid = field(default=lambda s: [{}])
-    reference: str = "baseline"
-    amount_is_shape: bool = False  # the strength itself is scanned (backlash clearance)
-    start_shape: str | None = None
-
-
-def _geom(lo: float, hi: float, n: int) -> list[float]:
-    return list(np.geomspace(lo, hi, n))
-
-
-PROBES: dict[str, Probe] = {p.term: p for p in (
-    Probe("tanh_friction", "F_c", lambda s: 1.0,
-          shapes=lambda s: [{"beta": b / s.v} for b in (1.0, 3.0, 10.0, 30.0)]),
-    Probe("coulomb_friction", "F_coulomb", lambda s: 1.0),
-    Probe("stribeck_friction", "F_stribeck", lambda s: 1.0,
-          shapes=lambda s: [{"v_stribeck": f * s.v} for f in (0.1, 0.3, 1.0)]),
-    Probe("asymmetric_friction", "F_asym", lambda s: 0.5, signed=True),
-    Probe("quadratic_damping", "c_quad", lambda s: 1.0 / s.v**2),
-    Probe("cubic_stiffness", "k_cubic", lambda s: 1.0 / s.z**3, signed=True),
-    Probe("end_stop", "k_stop", lambda s: 1.0 / s.z,
-          shapes=lambda s: [{"gap_stop": s.z_quantiles[q]} for q in (0.5, 0.75, 0.9, 0.97)]),
-    Probe("backlash", "gap_backlash", lambda s: 0.0, reference="zero", amount_is_shape=True,
-          shapes=lambda s: [{"gap_backlash": g} for g in (2e-6, 1e-5)]),
-    Probe("hysteresis", "F_hyst", lambda s: 0.5,
-          shapes=lambda s: [{"k_hyst": 0.5 / d} for d in (3e-5, 3e-4)]),
-    Probe("unmodelled_mode", "mass_mode", lambda s: 0.05,
-          shapes=lambda s: [{"f_mode": f, "zeta_mode": 0.15, "drive_base": d}
-                            for d in (1.0, 0.0)
-                            for f in _geom(1.5, 0.95 * s.f_high,
-                                           1 + int(np.log(0.95 * s.f_high / 1.5)
-                                                   / np.log(1.2)))],
-          start_shape="f_mode"),
-    Probe("offset_force", "F_offset", lambda s: 0.5, signed=True),
-    Probe("inertia_error", "dM", lambda s: 0.1, signed=True,
-          shapes=lambda s: [{"m_share": share} for share in (0.0, 1.0)]),
-)}
+def _centre(spec) -> float:
+    """A prior's centre in its own coordinate, as a value (a shape's default in a probe)."""
+    return float(spec.from_coordinate(spec.center))
 
 
 @dataclass
@@ -140,7 +80,9 @@ def dissipative_force(base_acc: np.ndarray, rel_vel: np.ndarray, m: float) -> fl
     return power / sigma_v
 
 
-def motion_scale(state: BaselineState, window: tuple[int, int], f_high: float) -> MotionScale:
+def motion_scale(state: BaselineState, window: tuple[int, int], f_high: float) -> DeviceScale:
+    """The device's scales (``DeviceScale``) from the baseline's simulated motion over the
+    window, its known (or estimated) masses and spring, and the analysed band."""
     start, stop = window
     z = state.rel_disp[start:stop]
     v = state.rel_vel[start:stop]
@@ -149,17 +91,21 @@ def motion_scale(state: BaselineState, window: tuple[int, int], f_high: float) -
     prob = state.problem
     gain = prob.known.get("m", 0.0) if prob.input_kind == "base_acc" else -1.0  # force input
     force = dissipative_force(prob.base_acc[start:stop], v, gain)
-    return MotionScale(z=float(np.sqrt(np.mean(zc**2))) or 1e-3,
+    values = dict(zip(prob.parameter_names, state.theta))
+    masses = {n: float(prob.known.get(n, values.get(n, np.nan))) for n in ("M", "m", "k")}
+    return DeviceScale(force=force or REFERENCE_DEVICE.force,
                        v=float(np.sqrt(np.mean(v**2))) or 1e-3,
-                       z_quantiles={q: float(np.quantile(az, q)) for q in (0.5, 0.75, 0.9, 0.97)},
-                       f_high=f_high, force=force)
+                       z=float(np.sqrt(np.mean(zc**2))) or 1e-3, f_high=f_high,
+                       M=masses["M"], m=masses["m"], k=masses["k"],
+                       z_quantiles={q: float(np.quantile(az, q)) for q in (0.5, 0.75, 0.9,
+                                                                           0.97)})
 
 
 def candidate_terms(structure_terms: tuple[str, ...], allowed: tuple[str, ...] | None = None
                     ) -> list[str]:
-    """Library terms that can be added to a structure: not already in it, with a probe, and,
-    for a refinement of another law (``Term.refines``), with that law in the structure."""
-    names = [t for t in TERMS if t in PROBES and t not in structure_terms
+    """Library terms that can be added to a structure: not already in it and, for a
+    refinement of another law (``Term.refines``), with that law in the structure."""
+    names = [t for t in TERMS if t not in structure_terms
              and (not TERMS[t].refines or set(TERMS[t].refines) & set(structure_terms))]
     if allowed is not None:
         unknown = [t for t in allowed if t not in TERMS]
@@ -169,7 +115,7 @@ def candidate_terms(structure_terms: tuple[str, ...], allowed: tuple[str, ...] |
     return names
 
 
-def signatures(state: BaselineState, scale: MotionScale,
+def signatures(state: BaselineState, scale: DeviceScale,
                candidates: list[str]) -> list[Signature]:
     """Signatures of every candidate at every shape of its grid (one simulation per term)."""
     problem = state.problem
@@ -177,10 +123,10 @@ def signatures(state: BaselineState, scale: MotionScale,
     base_terms = problem.structure.terms
     out: list[Signature] = []
     for name in candidates:
-        probe = PROBES[name]
         t = term(name)
+        probe = t.probe
         layout = Layout.of(base_terms + (name,))
-        defaults = {p.name: p.prior_mean for p in t.parameters}
+        defaults = {p.name: _centre(p.prior_on(scale)) for p in t.parameters}
         rows, meta = [], []
         for shape in probe.shapes(scale):
             values = {**defaults, **shape}

@@ -1,23 +1,28 @@
-"""Prior distributions of Tables 2 (linear model) and 4 (tanh model), in one place.
+"""Priors of an identification: the config's (Tables 2 and 4 of the paper), the library's
+defaults, and our priors beside the paper's.
 
-Each prior is a Gaussian truncated at zero (paper, 'Linear model' and 'Hyperbolic tangent').
+The distribution itself (:class:`PriorSpec`, its families) lives in ``harvester.model.priors``.
 The config section ``priors`` gives, per parameter, either ``mean`` or ``from: table1`` (the
 mean is then our Table 1 estimate, as the paper took its means from its Table 1), plus ``sd``
-and ``unit``.
+and ``unit``: a Gaussian truncated at ``lower`` (0 in the paper, 'Linear model' and
+'Hyperbolic tangent'); ``family: lognormal`` (mean = median, sd of ln x) or ``family:
+loguniform`` (``lower``, ``upper``) for the other families.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
-from scipy import stats
 
+from harvester.model.priors import REFERENCE_DEVICE, DeviceScale, PriorSpec
 from harvester.model.terms import BASE_PARAMETERS, TERMS
 from harvester.study import paper
+
+__all__ = ["PAPER_PRIORS", "PriorSpec", "default_prior", "prior_moments", "prior_spec",
+           "prior_table", "priors_for"]
 
 if TYPE_CHECKING:
     from harvester.inference.likelihood import Problem
@@ -26,26 +31,6 @@ if TYPE_CHECKING:
 PAPER_PRIORS: dict[str, Mapping[str, tuple[float, float | None]]] = {
     "linear": paper.TABLE2, "tanh": paper.TABLE4,
 }
-
-
-@dataclass(frozen=True)
-class PriorSpec:
-    """Gaussian prior N(mean, sd^2) truncated below at ``lower`` (0 in the paper), in ``unit``."""
-
-    name: str
-    mean: float
-    sd: float
-    unit: str
-    lower: float = 0.0
-
-    def distribution(self) -> Any:
-        """The truncated Gaussian as a frozen ``scipy.stats.truncnorm`` (upper bound +inf)."""
-        a = (self.lower - self.mean) / self.sd
-        return stats.truncnorm(a, np.inf, loc=self.mean, scale=self.sd)
-
-    def logpdf(self, x: Any) -> Any:
-        """Log density of the truncated prior (-inf below ``lower``)."""
-        return self.distribution().logpdf(x)
 
 
 def _prior_mean(name: str, entry: Mapping[str, Any], table1: Mapping[str, float]) -> float:
@@ -66,12 +51,25 @@ def _prior_mean(name: str, entry: Mapping[str, Any], table1: Mapping[str, float]
 
 
 def prior_spec(name: str, entry: Mapping[str, Any], table1: Mapping[str, float]) -> PriorSpec:
-    """One :class:`PriorSpec` from its config entry (keys mean|from, sd, unit, optional lower)."""
+    """One :class:`PriorSpec` from its config entry (keys mean|from, sd, unit, optional lower;
+    or family: loguniform with lower and upper; or family: lognormal with mean (the median)
+    and sd (of ln x))."""
+    family = str(entry.get("family", "normal"))
+    unit = str(entry.get("unit", ""))
+    if family == "loguniform":
+        try:
+            return PriorSpec.log_uniform(name, float(entry["lower"]), float(entry["upper"]),
+                                         unit)
+        except (KeyError, TypeError, ValueError) as err:
+            raise ValueError(f"priors.{name}: a log-uniform prior needs 0 < lower < upper "
+                             f"({err})") from None
     sd = float(entry.get("sd", np.nan))
     if not sd > 0.0:
         raise ValueError(f"priors.{name}: 'sd' must be a positive number, got {entry.get('sd')!r}")
-    return PriorSpec(name=name, mean=_prior_mean(name, entry, table1), sd=sd,
-                     unit=str(entry.get("unit", "")), lower=float(entry.get("lower", 0.0)))
+    if family == "lognormal":
+        return PriorSpec.log_normal(name, _prior_mean(name, entry, table1), sd, unit)
+    return PriorSpec(name=name, mean=_prior_mean(name, entry, table1), sd=sd, unit=unit,
+                     lower=float(entry.get("lower", 0.0)))
 
 
 def prior_moments(config_priors: Mapping[str, Mapping[str, Any]],
@@ -115,12 +113,12 @@ def prior_table(model_params: Sequence[str], specs: Mapping[str, PriorSpec],
                                        "paper_sd"])
 
 
-def default_prior(name: str) -> PriorSpec:
-    """The physics library's default prior of a parameter (used when config gives none)."""
+def default_prior(name: str, device: DeviceScale = REFERENCE_DEVICE) -> PriorSpec:
+    """The physics library's prior of a parameter on ``device`` (the paper's rig by default;
+    used where the config gives none)."""
     for p in BASE_PARAMETERS + tuple(q for t in TERMS.values() for q in t.parameters):
         if p.name == name:
-            lower = -np.inf if p.lower is None else p.lower
-            return PriorSpec(name=name, mean=p.prior_mean, sd=p.prior_sd, unit=p.unit, lower=lower)
+            return p.prior_on(device)
     raise KeyError(f"no prior for parameter {name!r}")
 
 

@@ -32,7 +32,7 @@ from harvester.inference.tmcmc import log_evidence
 log = logging.getLogger("harvester.inference.recording_fit")
 
 #: Columns of summary.csv.
-SUMMARY_COLUMNS = ["parameter", "unit", "mean", "sd", "q2.5", "q97.5", "prior_mean", "prior_sd"]
+SUMMARY_COLUMNS = ["parameter", "unit", "mean", "sd", "q2.5", "q97.5", "prior"]
 #: Seconds at the end of a low-passed record left out of the likelihood (the zero-phase
 #: filter's end effects).
 END_EFFECTS_S = 0.5
@@ -85,8 +85,7 @@ def parameter_table(idata: az.InferenceData, priors: Mapping[str, PriorSpec]) ->
         rows.append({"parameter": name, "unit": spec.unit if spec else "", "mean": x.mean(),
                      "sd": x.std(ddof=1) if x.size > 1 else np.nan,
                      "q2.5": np.quantile(x, 0.025), "q97.5": np.quantile(x, 0.975),
-                     "prior_mean": spec.mean if spec else np.nan,
-                     "prior_sd": spec.sd if spec else np.nan})
+                     "prior": spec.describe() if spec else ""})
     return pd.DataFrame(rows, columns=SUMMARY_COLUMNS)
 
 

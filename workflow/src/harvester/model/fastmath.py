@@ -26,7 +26,7 @@ from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic
 
-__all__ = ["exp", "expm1", "tanh", "sign"]
+__all__ = ["exp", "expm1", "log", "tanh", "sign"]
 
 _LN2_HI = 6.93147180369123816490e-01
 _LN2_LO = 1.90821492927058770002e-10
@@ -107,6 +107,40 @@ def exp(x):
     """exp(x) (0 below -700, exp(700) above 700)."""
     t, _, r = _reduce(x)
     return _two_to(t) * (1.0 + _expm1_reduced(r))
+
+
+_SQRT2 = 1.4142135623730951
+_TWO52 = 4503599627370496.0
+
+
+@nb.njit(error_model="numpy", cache=True)
+def log(x):
+    """ln x for x > 0 (x below 1e-300 is taken as 1e-300): x = 2^k m with m in
+    [sqrt(1/2), sqrt(2)), ln m = 2 atanh(s), s = (m - 1) / (m + 1), by its odd series to s^23
+    (|s| <= 0.172: truncation below 1e-19); k read from the exponent bits as a double (the
+    2^52 trick again, no integer conversion)."""
+    x = max(x, 1e-300)
+    bits = _bits(x)
+    k = _double((bits >> 52) | 0x4330000000000000) - _TWO52 - 1023.0
+    m = _double((bits & 0x000FFFFFFFFFFFFF) | 0x3FF0000000000000)
+    big = m > _SQRT2
+    m = 0.5 * m if big else m
+    k = k + 1.0 if big else k
+    s = (m - 1.0) / (m + 1.0)
+    s2 = s * s
+    p = 1.0 / 23.0
+    p = p * s2 + 1.0 / 21.0
+    p = p * s2 + 1.0 / 19.0
+    p = p * s2 + 1.0 / 17.0
+    p = p * s2 + 1.0 / 15.0
+    p = p * s2 + 1.0 / 13.0
+    p = p * s2 + 1.0 / 11.0
+    p = p * s2 + 1.0 / 9.0
+    p = p * s2 + 1.0 / 7.0
+    p = p * s2 + 1.0 / 5.0
+    p = p * s2 + 1.0 / 3.0
+    p = p * s2 + 1.0
+    return k * _LN2_HI + (2.0 * s * p + k * _LN2_LO)
 
 
 @nb.njit(error_model="numpy", cache=True)

@@ -28,10 +28,10 @@ coulomb_friction          linear device + Coulomb friction with stiction (Karnop
                           while sliding; while |w| < 0.5 mm/s it holds the applied force up to
                           the breakaway F [F sgn(w), sgn regularised as tanh(w / 1 mm/s)]
 stribeck_friction         F exp(-|w| / v_s) sgn_e(w), exponent 1, e = 0.2 mm/s, v_s drawn in
-                          [1, 8] mm/s [exponent 2: F exp(-(w/v_s)^2) sgn(w)]
+                          [1, 8] mm/s [a free exponent: F exp(-|w/v_s|^delta) sgn(w)]
 asymmetric_friction       friction stronger in one direction: the tanh law times (1 +- a),
                           i.e. f = A |tanh(beta w)|, beta the baseline's, sign of A drawn
-                          [A sgn(w)^2]
+                          [A tanh(w / v_asym)^2, its own transition]
 quadratic_damping         c |w|^1.8 sgn(w)  [c w |w|]
 cubic_stiffness           progressive (hardening) spring k |z|^2.5 sgn(z) [k z^3]; softening
                           at a visible strength turns the total stiffness negative within the
@@ -339,12 +339,12 @@ FAMILIES: dict[str, Family] = {f.effect: f for f in (
            shapes=lambda rng, motion: {"v_karnopp": 5e-4}, shape_order=("v_karnopp",)),
     Family("stribeck_friction", STRIBECK, "F_stribeck", "N",
            "F exp(-|w| / v_s) sgn_e(w) (exponent 1)",
-           "F_stribeck exp(-(w / v_stribeck)^2) sgn(w)", guess=0.5,
+           "F_stribeck exp(-|w / v_stribeck|^delta_stribeck) sgn(w)", guess=0.5,
            shapes=lambda rng, motion: {"v_s": _loguniform(rng, 1e-3, 8e-3)},
            shape_order=("v_s",)),
     Family("asymmetric_friction", ASYMMETRIC, "A", "N",
            "A |tanh(beta w)| (friction amplitude F_c + A up, F_c - A down; beta the baseline's)",
-           "F_asym sgn(w)^2", guess=0.2, signed=True,
+           "F_asym tanh(w / v_asym)^2", guess=0.2, signed=True,
            shapes=lambda rng, motion: {"beta_asym": motion["beta"]}, shape_order=("beta_asym",)),
     Family("quadratic_damping", POWER_DAMPING, "c_power", "N (s/m)^1.8",
            "c |w|^1.8 sgn(w)", "c_quad w |w|", guess=500.0,
@@ -366,7 +366,7 @@ FAMILIES: dict[str, Family] = {f.effect: f for f in (
     Family("hysteresis", BOUC_WEN, "F_hyst", "N",
            "Bouc-Wen n = 2: h' = (F/delta) w - beta |w||h|h - gamma w h^2, "
            "beta = gamma = 1/(2 F delta); pre-sliding displacement delta drawn in [0.1, 0.5] mm",
-           "Dahl h' = k_hyst (w - |w| h / F_hyst)", guess=0.3,
+           "Dahl h' = (F_hyst / delta_hyst) (w - |w| h / F_hyst)", guess=0.3,
            shapes=lambda rng, motion: {"delta": _loguniform(rng, 1e-4, 5e-4)},
            shape_order=("delta",)),
     Family("unmodelled_mode", ROTOR_MODE, "mass_2", "kg",

@@ -6,12 +6,13 @@ Every structure shares the base equation of motion, eq. (1) of Green et al. (201
 
 with c_m the translational viscous coefficient (N s/m). A term adds one named effect. Each
 term is one object in one file of this package (``model/terms/<name>.py``, a module-level
-``TERM``), holding everything about it: its parameters with units and priors, its equation,
-its force law (plain arithmetic that ``harvester.model.codegen`` compiles into each
-structure's kernel), the bound on its stiffness that sets the integrator's step, and its
-description. The registry (:data:`TERMS`) collects every module of the package and refuses a
-term that lacks any of these (:func:`register`); ``docs/adding-a-term.md`` walks through
-adding one.
+``TERM``), holding everything about it: its parameters with units and priors (written in the
+device's own scales, ``harvester.model.priors``, so that they travel to any device), its
+equation, its force law (plain arithmetic that ``harvester.model.codegen`` compiles into each
+structure's kernel), the bound on its stiffness that sets the integrator's step, its probe
+(how the diagnosis switches a little of it on to see its signature) and its description. The
+registry (:data:`TERMS`) collects every module of the package and refuses a term that lacks
+any of these (:func:`register`); ``docs/adding-a-term.md`` walks through adding one.
 
 Sign convention: a positive force opposes positive z or z' (it is added to the left-hand side
 of eq. 1). Kinds of term and the signature of their force law:
@@ -36,6 +37,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from harvester.model.priors import REFERENCE_DEVICE, DeviceScale, Prior, PriorSpec
+
 #: Regularising velocity (m/s) for sign-like friction laws: sgn(v) ~ tanh(v / V_EPS).
 V_EPS = 1.0e-3
 #: Largest velocity (m/s) and displacement (m) assumed when bounding stiffness for step control.
@@ -47,14 +50,44 @@ KINDS = ("screw", "mass", "inertia", "mode", "coupling")
 
 @dataclass(frozen=True)
 class Parameter:
-    """A physical parameter with its unit and default prior (Gaussian, truncated below)."""
+    """A physical parameter: its unit, its prior (in the device's scales) and what it is."""
 
     name: str
     unit: str
-    prior_mean: float
-    prior_sd: float
-    lower: float | None = 0.0
+    prior: Prior
     description: str = ""
+
+    def prior_on(self, device: DeviceScale = REFERENCE_DEVICE) -> PriorSpec:
+        """The parameter's prior on a device (the reference device: its default)."""
+        return self.prior.spec(self.name, self.unit, device)
+
+
+#: A grid of shape values (parameter -> value) from the device's scales.
+ShapeGrid = Callable[[DeviceScale], list[dict[str, float]]]
+
+
+@dataclass(frozen=True)
+class Probe:
+    """How the diagnosis switches on a small amount of a term to see its signature.
+
+    strength: the parameter whose zero switches the effect off; amount(device): the probe
+    strength; signed: the strength may be negative (two-sided test); shapes(device): grid of
+    the term's other parameters (others at their prior's centre); reference: "baseline" (effect
+    off = the baseline itself) or "zero" (the term kept with strength 0, when zero strength
+    still changes the structure, as a backlash coupling does); amount_is_shape: the strength
+    itself is scanned (backlash clearance). ``start_shape``: a shape parameter whose
+    posterior is a peak too narrow for a few hundred prior draws to hit (a resonance's
+    frequency): the candidate's TMCMC starts part of its particles where the detection's scan
+    places it.
+    """
+
+    strength: str
+    amount: Callable[[DeviceScale], float]
+    signed: bool = False
+    shapes: ShapeGrid = field(default=lambda d: [{}])
+    reference: str = "baseline"
+    amount_is_shape: bool = False
+    start_shape: str | None = None
 
 
 @dataclass(frozen=True)
@@ -87,9 +120,10 @@ class Term:
     signature of the term's ``kind`` (module docstring), using only arithmetic and
     ``harvester.model.fastmath`` so that the compiler vectorises them. ``rate_bound(p,
     motion)`` gets the parameters as a dict of arrays (one value per particle) and returns a
-    :class:`RateBound`. ``refines``: a refinement of one of these terms' laws, meaningless
-    without one of them (a Stribeck excess is over a sliding friction): a candidate only where
-    one is in the structure. ``n_states``: internal states the term adds.
+    :class:`RateBound`. ``probe``: how the diagnosis sees the term (:class:`Probe`).
+    ``refines``: a refinement of one of these terms' laws, meaningless without one of them (a
+    Stribeck excess is over a sliding friction): a candidate only where one is in the
+    structure. ``n_states``: internal states the term adds.
     """
 
     name: str
@@ -99,6 +133,7 @@ class Term:
     description: str
     force: Callable
     rate_bound: Callable[[dict, Motion], RateBound]
+    probe: Probe
     n_states: int = 0
     state_rates: Callable | None = None
     masses: Callable | None = None
@@ -110,11 +145,15 @@ class Term:
         return tuple(p.name for p in self.parameters)
 
 
+#: Eq. (1)'s own parameters, with the paper's rig's Table 1 values as default priors (a
+#: recording's initial modelling replaces them: ``harvester.initial``).
 BASE_PARAMETERS: tuple[Parameter, ...] = (
-    Parameter("M", "kg", 12.8, 1.0, 0.0, "effective mass m + J (2 pi / l)^2, eq. (2)"),
-    Parameter("m", "kg", 8.0, 0.5, 0.0, "oscillating mass"),
-    Parameter("k", "N/m", 250.0, 25.0, 0.0, "spring stiffness"),
-    Parameter("c_m", "N s/m", 170.0, 50.0, 0.0, "translational viscous damping b_m, eq. (3)"),
+    Parameter("M", "kg", Prior("normal", 12.8, 1.0),
+              "effective mass m + J (2 pi / l)^2, eq. (2)"),
+    Parameter("m", "kg", Prior("normal", 8.0, 0.5), "oscillating mass"),
+    Parameter("k", "N/m", Prior("normal", 250.0, 25.0), "spring stiffness"),
+    Parameter("c_m", "N s/m", Prior("normal", 170.0, 50.0),
+              "translational viscous damping b_m, eq. (3)"),
 )
 
 #: Laws of sliding friction (Dahl's saturates to Coulomb's): what a Stribeck excess or a
@@ -132,6 +171,8 @@ def check_term(t: Term) -> None:
             problems.append(f"no {what}")
     if not callable(t.force) or not callable(t.rate_bound):
         problems.append("force and rate_bound must be functions")
+    if not isinstance(t.probe, Probe) or t.probe.strength not in t.parameter_names:
+        problems.append("a probe (Probe) whose strength is one of its parameters")
     needs_rates = t.kind == "mode" or (t.kind == "screw" and t.n_states > 0)
     if needs_rates and not callable(t.state_rates):
         problems.append("a term with internal states needs state_rates")
@@ -140,8 +181,14 @@ def check_term(t: Term) -> None:
     if t.kind in ("mode", "coupling") and t.n_states != 2:
         problems.append(f"a {t.kind} term has 2 states, not {t.n_states}")
     for p in t.parameters:
-        if not p.unit or not p.description or not p.prior_sd > 0:
-            problems.append(f"parameter {p.name} needs a unit, a description and a prior sd > 0")
+        if not p.unit or not p.description or not isinstance(p.prior, Prior) or not p.prior.why:
+            problems.append(f"parameter {p.name} needs a unit, a description and a Prior with "
+                            "its reasoning (why)")
+            continue
+        try:
+            p.prior_on()
+        except ValueError as err:
+            problems.append(f"parameter {p.name}: {err}")
     names = [p.name for p in t.parameters]
     bad = [n for n in names if not n.isidentifier() or n.startswith("_")]
     if bad:

@@ -16,7 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from harvester.model.terms import Motion, Parameter, RateBound, Term
+from harvester.model.priors import DeviceScale, Prior
+from harvester.model.terms import Motion, Parameter, Probe, RateBound, Term
 
 #: Damping ratio of the contact (Kelvin-Voigt, on the reduced mass m J / (m + J)).
 BACKLASH_ZETA = 0.5
@@ -43,16 +44,37 @@ def rate_bound(p: dict, motion: Motion) -> RateBound:
     return RateBound(rate=8.0 * np.sqrt(np.abs(p["k_backlash"]) / reduced))
 
 
+#: The contact resonance sqrt(k_backlash / mu) / 2 pi (mu the reduced mass m J / (m + J)) as
+#: multiples of the analysed band's upper edge: the prior's mean and lower bound.
+CONTACT_BAND = (6.0, 4.0)
+
+
+def contact_stiffness(d: DeviceScale) -> float:
+    """mu (2 pi f_high)^2 (N/m): the stiffness whose contact resonance sits at the band's
+    edge; the prior is in multiples of it."""
+    mu = d.m * (d.M - d.m) / d.M if d.M > d.m > 0 else 0.25 * d.M
+    return mu * (2.0 * np.pi * d.f_high) ** 2
+
+
 TERM = Term(
     name="backlash", kind="coupling", n_states=2,
     parameters=(
-        Parameter("gap_backlash", "m", 1e-5, 1e-5, 0.0,
-                  "half dead zone in the screw-nut coupling (axial play of an unloaded ball "
-                  "nut: a few to tens of micrometres)"),
-        Parameter("k_backlash", "N/m", 1e7, 1e7, 1e6,
-                  "axial contact stiffness of the screw-nut coupling (ball nuts: 1e7-1e9)"),
+        Parameter("gap_backlash", "m", Prior(
+            "loguniform", 1e-6, 1e-3,
+            why="axial play of a ball nut: a micrometre when preloaded to a millimetre when worn"),
+            "half dead zone in the screw-nut coupling"),
+        Parameter("k_backlash", "N/m", Prior(
+            "normal", CONTACT_BAND[0] ** 2, 0.5 * CONTACT_BAND[0] ** 2, contact_stiffness,
+            lower=CONTACT_BAND[1] ** 2,
+            why="the contact's resonance 4-6 x above the analysed band: the recorded z'' cannot "
+                "tell a stiffer contact (a ball nut's 1e7-1e9 N/m) from it, and each step up "
+                "costs sub-steps"),
+            "axial contact stiffness of the screw-nut coupling"),
     ),
     equation="coupling force F_b = k_backlash dz(d, gap) + c_b d' in contact (compressive "
              "only), c_b at damping ratio 0.5 on m J / (m + J); J r'' = F_b - c_m r' - f(r')",
     description="dead zone between the mass and the screw-side inertia",
-    force=force, rate_bound=rate_bound, source=__file__)
+    force=force, rate_bound=rate_bound,
+    probe=Probe("gap_backlash", lambda d: 0.0, reference="zero", amount_is_shape=True,
+                shapes=lambda d: [{"gap_backlash": g} for g in (2e-6, 1e-5)]),
+    source=__file__)

@@ -1,12 +1,12 @@
-"""Coulomb (dry) friction: f = F_coulomb sgn(w), sgn regularised as tanh(w / V_EPS).
-"""
+"""Coulomb (dry) friction: f = F_coulomb sgn(w), sgn regularised as tanh(w / V_EPS)."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from harvester.model import fastmath as fm
-from harvester.model.terms import V_EPS, Motion, Parameter, RateBound, Term
+from harvester.model.priors import Prior
+from harvester.model.terms import V_EPS, Motion, Parameter, Probe, RateBound, Term
 
 
 def force(w, F_coulomb):
@@ -21,6 +21,10 @@ def rate_bound(p: dict, motion: Motion) -> RateBound:
 
 TERM = Term(
     name="coulomb_friction", kind="screw",
-    parameters=(Parameter("F_coulomb", "N", 8.4, 5.0, 0.0, "Coulomb friction force"),),
+    parameters=(Parameter("F_coulomb", "N", Prior(
+        "loguniform", 0.01, 2.0, "force",
+        why="a dry friction from a hundredth of the damping force the motion shows to twice it"),
+        "Coulomb friction force"),),
     equation="f = F_coulomb sgn(w), sgn regularised as tanh(w / 1 mm/s)",
-    description="Coulomb (dry) friction", force=force, rate_bound=rate_bound, source=__file__)
+    description="Coulomb (dry) friction", force=force, rate_bound=rate_bound,
+    probe=Probe("F_coulomb", lambda d: 1.0), source=__file__)

@@ -1,11 +1,11 @@
-"""Hardening (or softening) spring: f = k_cubic z^3.
-"""
+"""Hardening (or softening) spring: f = k_cubic z^3 (Duffing)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from harvester.model.terms import Motion, Parameter, RateBound, Term
+from harvester.model.priors import Prior
+from harvester.model.terms import Motion, Parameter, Probe, RateBound, Term
 
 
 def force(z, k_cubic):
@@ -20,7 +20,11 @@ def rate_bound(p: dict, motion: Motion) -> RateBound:
 
 TERM = Term(
     name="cubic_stiffness", kind="mass",
-    parameters=(Parameter("k_cubic", "N/m^3", 0.0, 2000.0, None,
-                          "cubic stiffness coefficient"),),
+    parameters=(Parameter("k_cubic", "N/m^3", Prior(
+        "normal", 0.0, 1.0, "k/z^2", lower=None,
+        why="hardening or softening; at the RMS displacement the cubic force is within about "
+            "the linear spring's (at 3 x it, nine times)"),
+        "cubic stiffness coefficient"),),
     equation="f = k_cubic z^3", description="hardening/softening spring",
-    force=force, rate_bound=rate_bound, source=__file__)
+    force=force, rate_bound=rate_bound,
+    probe=Probe("k_cubic", lambda d: 1.0 / d.z**3, signed=True), source=__file__)

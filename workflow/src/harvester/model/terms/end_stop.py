@@ -1,11 +1,16 @@
 """An end stop beyond a clearance: f = k_stop (|z| - gap_stop)_+ sgn(z).
+
+A force that acts only where the displacement exceeds the clearance, unlike a cubic spring,
+which acts everywhere; it stands for linear, Hertzian ((|z| - g)^1.5) and Hunt-Crossley
+contacts, whose differences lie in the first micrometres of contact.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from harvester.model.terms import Motion, Parameter, RateBound, Term
+from harvester.model.priors import Prior
+from harvester.model.terms import Motion, Parameter, Probe, RateBound, Term
 
 
 def force(z, gap_stop, k_stop):
@@ -22,8 +27,19 @@ def rate_bound(p: dict, motion: Motion) -> RateBound:
 TERM = Term(
     name="end_stop", kind="mass",
     parameters=(
-        Parameter("gap_stop", "m", 0.05, 0.03, 0.0, "clearance before contact"),
-        Parameter("k_stop", "N/m", 5000.0, 3000.0, 0.0, "contact stiffness"),
+        Parameter("gap_stop", "m", Prior(
+            "loguniform", 0.5, 5.0, "z",
+            why="a clearance the motion reaches: from half to five times the RMS displacement"),
+            "clearance before contact"),
+        Parameter("k_stop", "N/m", Prior(
+            "loguniform", 1.0, 1e5, "k",
+            why="from a rubber bumper as soft as the spring to a steel stop 1e5 x stiffer "
+                "(contact stiffnesses of steel parts: 1e6-1e9 N/m)"),
+            "contact stiffness"),
     ),
     equation="f = k_stop (|z| - gap_stop)_+ sgn(z)", description="end stop beyond a clearance",
-    force=force, rate_bound=rate_bound, source=__file__)
+    force=force, rate_bound=rate_bound,
+    probe=Probe("k_stop", lambda d: 1.0 / d.z,
+                shapes=lambda d: [{"gap_stop": d.z_quantiles[q]} for q in (0.5, 0.75, 0.9,
+                                                                           0.97)]),
+    source=__file__)

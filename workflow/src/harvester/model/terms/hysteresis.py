@@ -1,40 +1,55 @@
 """Pre-sliding friction with memory (Dahl 1968): the friction force h follows
-h' = k_hyst (w - |w| h / F_hyst), saturating at F_hyst while sliding.
 
-k_hyst (N/m) is the bristle (pre-sliding) stiffness, F_hyst / k_hyst the pre-sliding
-displacement.
+    h' = (F_hyst / delta_hyst) (w - |w| h / F_hyst),
+
+rising along a bristle of stiffness F_hyst / delta_hyst when the motion reverses and
+saturating at F_hyst while sliding. delta_hyst (m) is the pre-sliding displacement; delta
+-> 0 is Coulomb friction. Dahl's law is LuGre's (Canudas de Wit et al. 1995) without its
+bristle damping and Stribeck part, and the first-order Bouc-Wen form.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from harvester.model.terms import Motion, Parameter, RateBound, Term
+from harvester.model.priors import Prior
+from harvester.model.terms import Motion, Parameter, Probe, RateBound, Term
 
 
-def force(w, h, F_hyst, k_hyst):
+def force(w, h, F_hyst, delta_hyst):
     """f = h (N), the Dahl state."""
     return h + 0.0 * w
 
 
-def state_rates(w, h, F_hyst, k_hyst):
-    """h' = k_hyst (w - |w| h / F_hyst) (N/s)."""
-    return k_hyst * (w - abs(w) * h / F_hyst)
+def state_rates(w, h, F_hyst, delta_hyst):
+    """h' = (F_hyst / delta_hyst) (w - |w| h / F_hyst) (N/s)."""
+    return (F_hyst * w - abs(w) * h) / delta_hyst
 
 
 def rate_bound(p: dict, motion: Motion) -> RateBound:
-    """The bristle stiffness k_hyst, and the relaxation rate k_hyst v_bound / F_hyst."""
-    k = np.abs(p["k_hyst"])
-    return RateBound(stiffness=k,
-                     rate=k * motion.v_bound / np.maximum(np.abs(p["F_hyst"]), 1e-6))
+    """The bristle stiffness F / delta, and the relaxation rate v_bound / delta."""
+    delta = np.maximum(np.abs(p["delta_hyst"]), 1e-9)
+    return RateBound(stiffness=np.abs(p["F_hyst"]) / delta, rate=motion.v_bound / delta)
 
 
 TERM = Term(
     name="hysteresis", kind="screw", n_states=1,
     parameters=(
-        Parameter("F_hyst", "N", 2.0, 2.0, 1e-3, "saturation force of the pre-sliding branch"),
-        Parameter("k_hyst", "N/m", 2e4, 2e4, 1.0, "pre-sliding (bristle) stiffness"),
+        Parameter("F_hyst", "N", Prior(
+            "loguniform", 0.01, 2.0, "force",
+            why="its saturation force from a hundredth of the damping force the motion shows "
+                "to twice it"),
+            "saturation force of the pre-sliding branch"),
+        Parameter("delta_hyst", "m", Prior(
+            "loguniform", 1.0 / 300.0, 1.0, "z",
+            why="pre-sliding displacements (micrometres in ball screws, up to millimetres in "
+                "polymer contacts) from 1/300 of the RMS displacement, below which the data "
+                "cannot tell it from Coulomb friction, to the RMS displacement itself"),
+            "pre-sliding displacement F_hyst / (bristle stiffness)"),
     ),
-    equation="Dahl: h' = k_hyst (w - |w| h / F_hyst), f = h",
+    equation="Dahl: h' = (F_hyst / delta_hyst) (w - |w| h / F_hyst), f = h",
     description="pre-sliding friction with memory (Dahl model)",
-    force=force, state_rates=state_rates, rate_bound=rate_bound, source=__file__)
+    force=force, state_rates=state_rates, rate_bound=rate_bound,
+    probe=Probe("F_hyst", lambda d: 0.1 * d.force,
+                shapes=lambda d: [{"delta_hyst": f * d.z} for f in (0.01, 0.1)]),
+    source=__file__)

@@ -1,11 +1,12 @@
-"""The effective mass differs from the assumed value: M -> M + dM, m -> m + m_share dM
-(eq. 2: M = m + J (2 pi / l)^2).
+"""The effective mass differs from the assumed value (a payload, a rotor inertia mis-stated):
+M -> M + dM, m -> m + m_share dM (eq. 2: M = m + J (2 pi / l)^2). A secondary mode far above
+the band acts the same way; the diagnosis reports the two together.
 """
 
 from __future__ import annotations
 
-
-from harvester.model.terms import Motion, Parameter, RateBound, Term
+from harvester.model.priors import Prior
+from harvester.model.terms import Motion, Parameter, Probe, RateBound, Term
 
 
 def masses(M, m, dM, m_share):
@@ -26,12 +27,21 @@ def rate_bound(p: dict, motion: Motion) -> RateBound:
 TERM = Term(
     name="inertia_error", kind="inertia",
     parameters=(
-        Parameter("dM", "kg", 0.0, 1.0, None, "error of the assumed effective mass"),
-        Parameter("m_share", "-", 0.5, 0.5, 0.0,
-                  "share of dM on the oscillating mass, which also drives the device (-m y''): "
-                  "1 for a payload error, 0 for an error of the screw-side inertia "
-                  "J (2 pi / l)^2 alone, above 1 when the two errors differ in sign"),
+        Parameter("dM", "kg", Prior(
+            "normal", 0.0, 0.3, "M", lower=None,
+            why="a mass error of either sign, up to about a third of the effective mass per "
+                "sd (a forgotten payload, a mis-stated rotor inertia)"),
+            "error of the assumed effective mass"),
+        Parameter("m_share", "-", Prior(
+            "normal", 0.5, 0.5,
+            why="between an error of the screw-side inertia (0) and of the payload (1)"),
+            "share of dM on the oscillating mass, which also drives the device (-m y''): "
+            "1 for a payload error, 0 for an error of the screw-side inertia "
+            "J (2 pi / l)^2 alone, above 1 when the two errors differ in sign"),
     ),
     equation="M -> M + dM, m -> m + m_share dM (eq. 2: M = m + J (2 pi / l)^2)",
     description="effective mass differs from the assumed value",
-    force=force, masses=masses, rate_bound=rate_bound, source=__file__)
+    force=force, masses=masses, rate_bound=rate_bound,
+    probe=Probe("dM", lambda d: 0.008 * d.M, signed=True,
+                shapes=lambda d: [{"m_share": share} for share in (0.0, 1.0)]),
+    source=__file__)

@@ -1,10 +1,9 @@
-"""A constant force on the mass (gravity, a cable, a sensor bias): f = F_offset.
-"""
+"""A constant force on the mass (gravity on a tilted device, a cable, a sensor bias): f = F_offset."""
 
 from __future__ import annotations
 
-
-from harvester.model.terms import Motion, Parameter, RateBound, Term
+from harvester.model.priors import Prior
+from harvester.model.terms import Motion, Parameter, Probe, RateBound, Term
 
 
 def force(z, F_offset):
@@ -19,7 +18,10 @@ def rate_bound(p: dict, motion: Motion) -> RateBound:
 
 TERM = Term(
     name="offset_force", kind="mass",
-    parameters=(Parameter("F_offset", "N", 0.0, 5.0, None,
-                          "constant force (gravity, cable, bias)"),),
+    parameters=(Parameter("F_offset", "N", Prior(
+        "normal", 0.0, 0.5, "force", lower=None,
+        why="either sign, rarely more than the damping force the motion shows"),
+        "constant force (gravity, cable, bias)"),),
     equation="f = F_offset", description="constant force offset",
-    force=force, rate_bound=rate_bound, source=__file__)
+    force=force, rate_bound=rate_bound,
+    probe=Probe("F_offset", lambda d: 0.1 * d.force, signed=True), source=__file__)

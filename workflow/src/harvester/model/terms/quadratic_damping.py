@@ -1,11 +1,11 @@
-"""Velocity-squared (fluid-like) damping: f = c_quad w |w|.
-"""
+"""Velocity-squared (fluid-like) damping: f = c_quad w |w| (an orifice, air drag)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from harvester.model.terms import Motion, Parameter, RateBound, Term
+from harvester.model.priors import Prior
+from harvester.model.terms import Motion, Parameter, Probe, RateBound, Term
 
 
 def force(w, c_quad):
@@ -20,7 +20,11 @@ def rate_bound(p: dict, motion: Motion) -> RateBound:
 
 TERM = Term(
     name="quadratic_damping", kind="screw",
-    parameters=(Parameter("c_quad", "N s^2/m^2", 0.0, 200.0, 0.0,
-                          "quadratic damping coefficient"),),
+    parameters=(Parameter("c_quad", "N s^2/m^2", Prior(
+        "loguniform", 0.01, 2.0, "force/v^2",
+        why="at the RMS velocity the quadratic force is from a hundredth of the damping force "
+            "the motion shows to twice it"),
+        "quadratic damping coefficient"),),
     equation="f = c_quad w |w|", description="velocity-squared (fluid-like) damping",
-    force=force, rate_bound=rate_bound, source=__file__)
+    force=force, rate_bound=rate_bound, probe=Probe("c_quad", lambda d: 1.0 / d.v**2),
+    source=__file__)

@@ -1,7 +1,12 @@
-"""Stribeck effect: the excess of breakaway over sliding friction, fading as sliding
-speeds up: f = F_stribeck exp(-(w / v_stribeck)^2) sgn(w).
+"""Stribeck effect: the excess of breakaway over sliding friction, fading as sliding speeds
+up (Armstrong-Helouvry, Dupont and Canudas de Wit 1994):
 
-A refinement of a sliding friction law (``SLIDING_FRICTION``): meaningless without one.
+    f = F_stribeck exp(-|w / v_stribeck|^delta_stribeck) sgn(w),
+
+the exponent covering the literature's exponential (1) and Gaussian (2) decays; the sign
+switches over a tenth of the Stribeck velocity, so that the excess is reached at low speed
+whatever the device's scale. A refinement of a sliding friction law (``SLIDING_FRICTION``):
+meaningless without one.
 """
 
 from __future__ import annotations
@@ -9,27 +14,50 @@ from __future__ import annotations
 import numpy as np
 
 from harvester.model import fastmath as fm
-from harvester.model.terms import SLIDING_FRICTION, V_EPS, Motion, Parameter, RateBound, Term
+from harvester.model.priors import Prior
+from harvester.model.terms import (SLIDING_FRICTION, Motion, Parameter, Probe, RateBound,
+                                   Term)
+
+#: The sign's transition as a share of the Stribeck velocity.
+SIGN_SHARE = 0.1
 
 
-def force(w, F_stribeck, v_stribeck):
-    """f = F_stribeck exp(-(w / v_stribeck)^2) tanh(w / V_EPS) (N)."""
-    r = w / v_stribeck
-    return F_stribeck * fm.exp(-r * r) * fm.tanh(w / V_EPS)
+def force(w, F_stribeck, v_stribeck, delta_stribeck):
+    """f = F_stribeck exp(-|w / v_s|^delta) tanh(w / (0.1 v_s)) (N)."""
+    r = abs(w / v_stribeck)
+    decay = fm.exp(-fm.exp(delta_stribeck * fm.log(r + 1e-300)))
+    return F_stribeck * decay * fm.tanh(w / (SIGN_SHARE * v_stribeck))
 
 
 def rate_bound(p: dict, motion: Motion) -> RateBound:
-    """The sign's slope F / V_EPS plus the decay's 2 F / v_stribeck."""
+    """The sign's slope F / (0.1 v_s) plus the decay's delta F / v_s."""
     a = np.abs(p["F_stribeck"])
-    return RateBound(damping=a / V_EPS + 2.0 * a / np.maximum(np.abs(p["v_stribeck"]), 1e-6))
+    vs = np.maximum(np.abs(p["v_stribeck"]), 1e-6)
+    return RateBound(damping=a / (SIGN_SHARE * vs) + np.abs(p["delta_stribeck"]) * a / vs)
 
 
 TERM = Term(
     name="stribeck_friction", kind="screw",
     parameters=(
-        Parameter("F_stribeck", "N", 2.0, 2.0, 0.0, "excess of breakaway over sliding friction"),
-        Parameter("v_stribeck", "m/s", 0.02, 0.02, 1e-4, "Stribeck velocity"),
+        Parameter("F_stribeck", "N", Prior(
+            "loguniform", 0.01, 2.0, "force",
+            why="breakaway exceeds sliding friction by a hundredth to twice the damping force "
+                "the motion shows"),
+            "excess of breakaway over sliding friction"),
+        Parameter("v_stribeck", "m/s", Prior(
+            "loguniform", 0.01, 3.0, "v",
+            why="the Stribeck velocity from 1/100 of the RMS velocity to 3 x it: below, the "
+                "data cannot see the excess; above, it is viscous-like"),
+            "Stribeck velocity"),
+        Parameter("delta_stribeck", "-", Prior(
+            "normal", 1.5, 0.5, lower=0.5, upper=3.0,
+            why="the decay's exponent: 1 (exponential) and 2 (Gaussian) are the literature's "
+                "forms"),
+            "exponent of the Stribeck decay"),
     ),
-    equation="f = F_stribeck exp(-(w / v_stribeck)^2) sgn(w)",
+    equation="f = F_stribeck exp(-|w / v_stribeck|^delta_stribeck) sgn(w)",
     description="Stribeck effect: friction falls from breakaway as sliding speeds up",
-    force=force, rate_bound=rate_bound, refines=SLIDING_FRICTION, source=__file__)
+    force=force, rate_bound=rate_bound, refines=SLIDING_FRICTION,
+    probe=Probe("F_stribeck", lambda d: 1.0,
+                shapes=lambda d: [{"v_stribeck": f * d.v} for f in (0.1, 0.3, 1.0)]),
+    source=__file__)

@@ -9,7 +9,8 @@ from __future__ import annotations
 import numpy as np
 
 from harvester.model import fastmath as fm
-from harvester.model.terms import Motion, Parameter, RateBound, Term
+from harvester.model.priors import Prior
+from harvester.model.terms import Motion, Parameter, Probe, RateBound, Term
 
 
 def force(w, F_c, beta):
@@ -25,8 +26,19 @@ def rate_bound(p: dict, motion: Motion) -> RateBound:
 TERM = Term(
     name="tanh_friction", kind="screw",
     parameters=(
-        Parameter("F_c", "N", 8.4, 5.0, 0.0, "friction force amplitude"),
-        Parameter("beta", "s/m", 100.0, 100.0, 0.0, "steepness at velocity reversal"),
+        Parameter("F_c", "N", Prior(
+            "loguniform", 0.01, 2.0, "force",
+            why="a sliding friction from a hundredth of the damping force the motion shows "
+                "to twice it (friction is part of that force)"),
+            "friction force amplitude"),
+        Parameter("beta", "s/m", Prior(
+            "loguniform", 1.0 / 3.0, 300.0, "1/v",
+            why="the transition velocity 1 / beta from 3 x the RMS velocity (friction almost "
+                "viscous) to 1/300 of it (a sign law at any resolution the data have)"),
+            "steepness at velocity reversal"),
     ),
     equation="f = F_c tanh(beta w)", description="hyperbolic tangent friction (Table 4)",
-    force=force, rate_bound=rate_bound, source=__file__)
+    force=force, rate_bound=rate_bound,
+    probe=Probe("F_c", lambda d: 1.0,
+                shapes=lambda d: [{"beta": b / d.v} for b in (1.0, 3.0, 10.0, 30.0)]),
+    source=__file__)

@@ -1,16 +1,20 @@
-"""A secondary resonance inside the band, on the mass or on the screw side.
+"""A secondary resonance, on the mass or on the screw side (a flexible mount, a rotor on a
+flexible coupling, a rocking mass):
 
-u'' + 2 zeta w_n u' + w_n^2 u = -(z'' + drive_base y''), with w_n = 2 pi f_mode; the force
-on the mass is m_2 (w_n^2 u + 2 zeta w_n u'), m_2 = mass_mode. drive_base = 1 is a mode
-attached to the mass (driven by its absolute acceleration), 0 one on the screw side (a
-rotor on a flexible coupling, driven by z'').
+    u'' + 2 zeta w_n u' + w_n^2 u = -(z'' + drive_base y''),   w_n = 2 pi f_mode,
+
+its force on the mass m_2 (w_n^2 u + 2 zeta w_n u'), m_2 = mass_mode. drive_base = 1 is a mode
+attached to the mass (driven by its absolute acceleration), 0 one on the screw side (driven by
+z''). A mode far above the band acts as a mass (``inertia_error``): the diagnosis reports the
+two together.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from harvester.model.terms import Motion, Parameter, RateBound, Term
+from harvester.model.priors import Prior
+from harvester.model.terms import Motion, Parameter, Probe, RateBound, Term
 
 
 def force(u, ud, f_mode, zeta_mode, mass_mode, drive_base):
@@ -32,18 +36,40 @@ def rate_bound(p: dict, motion: Motion) -> RateBound:
     return RateBound(rate=wn * np.sqrt(1.0 + ratio) * (1.0 + 2.0 * np.abs(p["zeta_mode"])))
 
 
+def _frequency_grid(d) -> list[float]:
+    top = 0.95 * d.f_high
+    return list(np.geomspace(1.5, top, 1 + int(np.log(top / 1.5) / np.log(1.2))))
+
+
 TERM = Term(
     name="unmodelled_mode", kind="mode", n_states=2,
     parameters=(
-        Parameter("f_mode", "Hz", 5.0, 3.0, 0.1, "natural frequency of the secondary mode"),
-        Parameter("zeta_mode", "-", 0.05, 0.05, 1e-3, "damping ratio of the secondary mode"),
-        Parameter("mass_mode", "kg", 0.5, 0.5, 0.0, "modal mass of the secondary mode"),
-        Parameter("drive_base", "-", 0.5, 0.5, 0.0,
-                  "share of the base acceleration in the mode's drive: 1 for a mode attached "
-                  "to the mass (driven by its absolute acceleration x'' = z'' + y''), 0 for "
-                  "one on the screw side (a rotor on a flexible coupling, driven by z'')"),
+        Parameter("f_mode", "Hz", Prior(
+            "loguniform", 0.05, 4.0, "f_high",
+            why="anywhere from near zero to four times the analysed band's upper edge (above "
+                "the band a mode acts as a mass)"),
+            "natural frequency of the secondary mode"),
+        Parameter("zeta_mode", "-", Prior(
+            "loguniform", 0.005, 0.5,
+            why="damping ratios of structural modes (0.5 %) to heavily damped mounts (50 %)"),
+            "damping ratio of the secondary mode"),
+        Parameter("mass_mode", "kg", Prior(
+            "loguniform", 0.001, 1.0, "M",
+            why="a modal mass from a thousandth of the effective mass to all of it"),
+            "modal mass of the secondary mode"),
+        Parameter("drive_base", "-", Prior(
+            "normal", 0.5, 0.5,
+            why="between a mode on the mass (1) and one on the screw side (0)"),
+            "share of the base acceleration in the mode's drive: 1 for a mode attached "
+            "to the mass (driven by its absolute acceleration x'' = z'' + y''), 0 for "
+            "one on the screw side (a rotor on a flexible coupling, driven by z'')"),
     ),
     equation="u'' + 2 zeta w_n u' + w_n^2 u = -(z'' + drive_base y''), force on the mass "
              "m_2 (w_n^2 u + 2 zeta w_n u')",
     description="secondary resonance inside the band, on the mass or the screw side",
-    force=force, state_rates=state_rates, rate_bound=rate_bound, source=__file__)
+    force=force, state_rates=state_rates, rate_bound=rate_bound,
+    probe=Probe("mass_mode", lambda d: 0.004 * d.M,
+                shapes=lambda d: [{"f_mode": f, "zeta_mode": 0.15, "drive_base": b}
+                                  for b in (1.0, 0.0) for f in _frequency_grid(d)],
+                start_shape="f_mode"),
+    source=__file__)
