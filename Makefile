@@ -28,7 +28,9 @@ test-slow: $(STAMP)
 	$(BIN)/python -m pytest -m slow
 
 benchmark: $(STAMP)
+	$(BIN)/python benchmarks/bench_simulator.py
 	$(BIN)/python benchmarks/bench_tmcmc.py
+	$(BIN)/python benchmarks/bench_evidence_spread.py
 	$(BIN)/python benchmarks/bench_resampling.py
 	$(BIN)/python benchmarks/bench_evidence.py
 	$(BIN)/python benchmarks/bench_reference.py

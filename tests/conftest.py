@@ -18,13 +18,22 @@ SNAKEMAKE = Path(sys.executable).with_name("snakemake")
 def small_config() -> dict:
     """The study's config with short records and a small sampler, for rule-level tests."""
     cfg = copy.deepcopy(yaml.safe_load((ROOT / "config/config.yaml").read_text()))
+    cfg["recordings"] = ["config/recordings.tsv"]  # the paper study's sheet alone (no EMPS)
     cfg["rig"]["records"]["training"]["duration_s"] = 10.0
     cfg["rig"]["records"]["validation"]["duration_s"] = 12.0
     cfg["rig"]["static_test"]["repeats"] = 6
     cfg["preprocess"]["training_samples"] = 1700  # the diagnosis needs 6.8 s with the lead-in
     cfg["tmcmc"].update(particles=200, chains=2, mcmc_steps=1)
     cfg["predictive"].update(samples=40, short_window_s=[2.0, 6.0])
-    cfg["diagnosis"].update(particles=100, chains=1, rounds=1, top=2, bootstrap=60)
+    cfg["diagnosis"].update(particles=100, chains=1, rounds=1, top=2, bootstrap=60,
+                            candidates=["tanh_friction", "cubic_stiffness"])
+    # the electrical half and the power it makes: the same rules at a token budget
+    cfg["electrical"].update(fit_seconds=1.0, structures=["inductive"])
+    cfg["electrical"]["tmcmc"].update(particles=40, max_mcmc_steps=2)
+    cfg["power"].update(draws=20, record_s=5.0)
+    cfg["power"]["calibration"].update(draws=20)
+    for exc in cfg["power"]["excitations"].values():
+        exc["duration_s"] = 12.0
     return cfg
 
 
@@ -54,3 +63,14 @@ def make_study_dir(path: Path, cfg: dict | None = None) -> Path:
 def study_dir(tmp_path_factory) -> Path:
     """A small study, fixture data generated once per test session."""
     return make_study_dir(tmp_path_factory.mktemp("study"))
+
+
+def fake_slurm(bin_dir: Path, marker: Path) -> dict:
+    """sbatch/sinfo/squeue that record being called and fail: a dry run must not call them."""
+    bin_dir.mkdir()
+    for tool in ("sbatch", "sinfo", "squeue", "sacct", "scancel"):
+        script = bin_dir / tool
+        script.write_text(f"#!/bin/sh\necho {tool} >> {marker}\nexit 1\n")
+        script.chmod(0o755)
+    return dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}",
+                PYTHONWARNINGS="ignore")

@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from conftest import ROOT, SNAKEMAKE
+from conftest import ROOT, SNAKEMAKE, fake_slurm
 
 from harvester.grid import scoring as det
 
@@ -161,21 +161,10 @@ def _workdir(tmp_path: Path, cfg: dict) -> tuple[Path, Path]:
     return tmp_path, snakefile
 
 
-def _fake_slurm(bin_dir: Path, marker: Path) -> dict:
-    """sbatch/sinfo/squeue that record being called and fail: a dry run must not call them."""
-    bin_dir.mkdir()
-    for tool in ("sbatch", "sinfo", "squeue", "sacct", "scancel"):
-        script = bin_dir / tool
-        script.write_text(f"#!/bin/sh\necho {tool} >> {marker}\nexit 1\n")
-        script.chmod(0o755)
-    return dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}",
-                PYTHONWARNINGS="ignore")
-
-
 def test_slurm_profile_dry_run_shows_rules_and_resources(tmp_path):
     workdir, snakefile = _workdir(tmp_path, _small_detection_config())
     marker = tmp_path / "called.txt"
-    env = _fake_slurm(tmp_path / "bin", marker)
+    env = fake_slurm(tmp_path / "bin", marker)
     cmd = [str(SNAKEMAKE), "--profile", str(ROOT / "profiles/slurm"), "-n", "detection_all",
            "-s", str(snakefile), "-d", str(workdir), "--configfile", str(workdir / "config.yaml")]
     proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=300)
@@ -228,17 +217,32 @@ def test_small_grid_runs_end_to_end(tmp_path):
     assert res["p_value"].between(0.0, 1.0).all()
 
 
-def test_tied_counts_an_effect_reported_indistinguishable_from_the_first():
-    d = {**_diag("stribeck_friction", "coulomb_friction"),
-         "indistinguishable": [["stribeck_friction", "coulomb_friction"]]}
-    rows = det.results_table([(_truth("coulomb_friction", 0.5, 0, "linear"), d),
-                              (_truth("end_stop", 0.5, 0), _diag("cubic_stiffness"))])
-    by = rows.set_index("effect")
-    assert not by.loc["coulomb_friction", "named"] and by.loc["coulomb_friction", "tied"]
-    assert not by.loc["end_stop", "tied"]
-    table = det.detection_table(rows).set_index("effect")
+def _tie(*effects):
+    return {"verdict": "missing_physics", "missing": [], "detection": {"p_value": 0.01},
+            "ties": [{"effects": list(effects)}]}
+
+
+def test_outcomes_named_tied_wrong_missed():
+    rows = det.results_table([
+        (_truth("coulomb_friction", 0.5, 0, "linear"), _tie("stribeck_friction",
+                                                              "coulomb_friction")),
+        (_truth("end_stop", 0.5, 0), _diag("cubic_stiffness")),
+        (_truth("end_stop", 0.5, 1), _tie("cubic_stiffness", "unmodelled_mode")),
+        (_truth("end_stop", 0.5, 2), _diag("end_stop")),
+        (_truth("end_stop", 0.5, 3), _flagged_unnamed()),
+        (_truth("end_stop", 0.5, 4), _diag()),
+        # the literature generator's truth states its own correct names
+        ({**_truth("lugre", 0.5, 0), "correct_names": ["hysteresis"]}, _diag("hysteresis")),
+        ({**_truth("lugre", 0.5, 1), "correct_names": ["hysteresis"]}, _diag("lugre")),
+    ]).set_index(["effect", "seed"])
+    assert list(rows["outcome"]) == ["tied", "wrong", "wrong", "named", "missed", "missed",
+                                     "named", "wrong"]
+    assert rows.loc[("coulomb_friction", 0), "named_effect"] == \
+        "stribeck_friction | coulomb_friction"
+    table = det.detection_table(rows.reset_index()).set_index("effect")
     assert table.loc["coulomb_friction", "tied_rate"] == 1.0
-    assert table.loc["end_stop", "tied_rate"] == 0.0
+    assert table.loc["end_stop", "wrong_rate"] == 0.4
+    assert table.loc["end_stop", "missed_rate"] == 0.4
 
 
 def _informed(diagnosis, lam=0.1, window=(1.0, 16.0), rate=256.0, alpha=0.05):
@@ -269,28 +273,28 @@ def test_information_is_the_tempered_likelihood_gain_of_what_the_baseline_leaves
 
 def test_goal_summary_pools_effects_and_separates_the_nameable():
     def pair(effect, seed, u, *missing, tie=None):
-        d = _informed(_diag(*missing))
-        if tie:
-            d["indistinguishable"] = [tie]
+        d = _informed(_tie(*tie) if tie else _diag(*missing))
         return {**_truth(effect, 0.5, seed), "unabsorbed_to_noise": u}, d
 
     rows = det.results_table([
         pair("end_stop", 0, 0.5, "end_stop"),
-        pair("end_stop", 1, 0.5, "cubic_stiffness", "end_stop",
-             tie=["cubic_stiffness", "end_stop"]),
+        pair("end_stop", 1, 0.5, tie=["cubic_stiffness", "end_stop"]),
+        pair("end_stop", 2, 0.5, "cubic_stiffness"),
         pair("quadratic_damping", 0, 0.03),                        # adequate, 0.17 nats
         pair("inertia_error", 0, 0.12),                            # adequate, 2.8 nats
         ({**_truth("none_tanh", 0.0, 0)}, _informed(_diag())),
     ])
     s = det.goal_summary(rows).set_index("ratio").loc[0.5]
-    assert (s["scenarios"], s["named"], s["tied"]) == (4, 1, 2)
-    assert (s["nameable"], s["named_nameable"], s["tied_nameable"]) == (2, 1, 2)
-    assert s["named_rate_nameable"] == 0.5 and s["named_rate"] == 0.25
+    assert (s["scenarios"], s["named"], s["tied"], s["wrong"]) == (5, 1, 2, 1)
+    assert (s["nameable"], s["named_nameable"], s["tied_nameable"]) == (3, 1, 2)
+    assert s["wrong_nameable"] == 1 and s["missed_nameable"] == 0
+    assert s["named_rate_nameable"] == pytest.approx(1 / 3) and s["named_rate"] == 0.2
     assert s["not_nameable"] == "inertia_error, quadratic_damping"
-    assert s["named_nameable_lo"] < 0.5 < s["named_nameable_hi"]
+    assert s["named_nameable_lo"] < 1 / 3 < s["named_nameable_hi"]
+    assert not s["meets_wrong_goal_nameable"]
     assert not s["meets_goal"] and not s["meets_goal_nameable"]
     table = det.detection_table(rows).set_index("effect")
-    assert (table.loc["end_stop", "nameable"], table.loc["end_stop", "named_nameable"]) == (2, 1)
+    assert (table.loc["end_stop", "nameable"], table.loc["end_stop", "named_nameable"]) == (3, 1)
     assert table.loc["quadratic_damping", "nameable"] == 0
 
 
@@ -299,3 +303,21 @@ def test_figure_with_the_information_panel(results, tmp_path):
     path = tmp_path / "rates.png"
     det.detection_figure(det.detection_table(rows), det.false_alarms(rows), path, results=rows)
     assert path.stat().st_size > 20_000
+
+
+def test_literature_generator_writes_a_scenario_the_grid_scores(tmp_path):
+    from harvester.data.daq import read_recording
+    from harvester.grid.generators import make_scenario_files
+
+    csv, js = tmp_path / "r.csv", tmp_path / "r.json"
+    truth = make_scenario_files("literature", "duffing", 0.5, 0, {"duration_s": 6.0, "seed": 7},
+                                {}, {}, csv, js)
+    assert truth["correct_names"] == ["cubic_stiffness"] and truth["baseline"] == "tanh"
+    assert set(truth["known"]) == {"M", "m", "k"}
+    assert truth["contribution_ratio"] == pytest.approx(0.5, rel=0.02)
+    rec = read_recording(csv)
+    assert list(rec.columns)[:3] == ["time", "base_acc", "rel_acc"] and len(rec) == 6 * 256
+    row = det.score(truth, _diag("cubic_stiffness"))
+    assert row["outcome"] == "named"
+    with pytest.raises(ValueError, match="generator"):
+        make_scenario_files("mine", "duffing", 0.5, 0, {}, {}, {}, csv, js)

@@ -247,3 +247,37 @@ def test_candidate_priors_follow_the_device_from_the_papers_rig():
     quad = candidate_priors("quadratic_damping", other)["c_quad"]
     assert quad.upper * other.v**2 == pytest.approx(
         4 * candidate_priors("quadratic_damping", rig)["c_quad"].upper * rig.v**2)
+
+def _result(effect, delta, se=0.3, accepted=True):
+    from harvester.diagnosis.confirm import CandidateResult
+    return CandidateResult(effect, None, delta, se, 3.0 + 2 * se, accepted)
+
+
+def test_an_effect_is_named_alone_only_beyond_the_threshold_of_every_different_rival():
+    from harvester.diagnosis.confirm import ConfirmSettings, mark_ties
+    cs = ConfirmSettings()
+    # a physically different rival 2 nats behind: a tie, both ways
+    results = [_result("unmodelled_mode", 20.0), _result("inertia_error", 18.0)]
+    mark_ties(results, cs)
+    assert not results[0].named and results[0].indistinguishable_from == ["inertia_error"]
+    assert results[1].indistinguishable_from == ["unmodelled_mode"]
+    # the same physics in another form does not tie; a rival 10 nats behind does not either
+    results = [_result("coulomb_friction", 20.0), _result("tanh_friction", 19.5),
+               _result("stribeck_friction", 10.0)]
+    mark_ties(results, cs)
+    assert results[0].named
+    # a rival that was not accepted still ties when within the threshold
+    results = [_result("end_stop", 5.0), _result("cubic_stiffness", 3.5, accepted=False)]
+    mark_ties(results, cs)
+    assert not results[0].named
+
+
+def test_separating_experiments_are_the_recordings_own_scaled_and_a_sweep():
+    from harvester.diagnosis.separate import proposed_experiments
+    u = np.random.default_rng(0).standard_normal(2048)
+    exps = proposed_experiments(u, 1 / 256.0, 16.0)
+    assert [e.name for e in exps] == ["twice_amplitude", "half_amplitude", "sine_sweep"]
+    np.testing.assert_allclose(exps[0].base_acc, 2 * u)
+    sweep = exps[2].base_acc
+    assert sweep.size == u.size
+    assert np.sqrt(np.mean(sweep[256:-256] ** 2)) == pytest.approx(np.std(u), rel=0.05)

@@ -13,6 +13,7 @@ import yaml
 
 from harvester import emps
 from harvester.data.errors import DataError
+from harvester.data.sheet import load_sheets
 from harvester.initial.frf import fit_linear_frf
 from harvester.inference.identify import TMCMCSettings, identify
 from harvester.inference.priors import PriorSpec
@@ -20,7 +21,11 @@ from harvester.model.simulate import simulate
 
 ROOT = Path(__file__).parents[1]
 CFG = yaml.safe_load((ROOT / "config/config.yaml").read_text())["emps"]
-TRAINING, VALIDATION = ROOT / CFG["training"], ROOT / CFG["validation"]
+#: The EMPS study's recordings, from its sheet.
+_SHEET = load_sheets("config/emps/recordings.tsv", bases=(ROOT,))
+_GROUP = _SHEET.groups["emps"]
+TRAINING, VALIDATION = (ROOT / _SHEET.file(_GROUP.training),
+                        ROOT / _SHEET.file(_GROUP.validation[0]))
 #: Published parameters in our layout order for the model viscous + coulomb_friction.
 MODEL = emps.BASELINE_TERMS + ("coulomb_friction",)
 

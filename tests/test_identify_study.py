@@ -27,7 +27,7 @@ def tanh_posterior():
                            output_filter=(pre["lowpass_hz"], pre["filter_order"]))
     # the paper's Table 1 means (our own initial estimates come from rules tested elsewhere)
     priors = prior_moments(CONFIG["priors"], {"c_m": 170.0, "F_c": 8.4})
-    settings = TMCMCSettings(particles=500, chains=2, seed=5, mcmc_steps=3, target_accept=0.25)
+    settings = TMCMCSettings(particles=300, chains=2, seed=5, mcmc_steps=3, target_accept=0.25)
     return problem, identify(problem, priors, settings)
 
 

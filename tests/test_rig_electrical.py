@@ -140,7 +140,8 @@ def test_loaded_record_voltage_channel_has_its_own_noise() -> None:
     """Converted load voltage = the true v_ab through the DAQ filter, plus the voltmeter's
     noise (noise_V RMS; quantisation adds LSB^2/12)."""
     sim = el.simulate_loaded_record(RIG, "loaded_1ohm", duration_s=4.0)
-    volts = pd.DataFrame({"time": sim.time, "ai0": sim.ai0, "ai1": sim.ai1, "ai2": sim.ai2})
+    volts = pd.DataFrame({"time": sim.time, "ai0": sim.ai0, "ai1": sim.ai1, "ai2": sim.ai2,
+                          "ai3": sim.ai3})
     frame = daq.to_accelerations(
         volts, daq.loaded_record_metadata(RIG, sim.name, sim.time.size, sim.seed, sim.load_ohm))
     noise = frame["voltage"].to_numpy() - sim.truth["voltage"]
@@ -173,10 +174,11 @@ def test_loaded_raw_data_regenerate_bit_for_bit_and_verify(regenerated) -> None:
 @pytest.mark.parametrize("record", ["open_circuit", "loaded_2ohm"])
 def test_loaded_raw_record_reads_and_converts_with_a_voltage_column(record) -> None:
     raw, meta = daq.read_raw_record(RAW / f"{record}.csv", RAW / f"{record}.json")
-    assert list(raw.columns) == ["time", "ai0", "ai1", "ai2"]
+    assert list(raw.columns) == ["time", "ai0", "ai1", "ai2", "ai3"]
     assert meta["simulated"] is True and "ASSUMED" in meta["generator"]["constants"]
     assert meta["load"]["resistance_ohm"] == el.load_of(RIG, record)
     assert len(raw) == round(RIG["loaded_records"][record]["duration_s"] * 256)
     acc = daq.to_accelerations(raw, meta)
-    assert list(acc.columns) == ["time", "base_acc", "mass_acc", "rel_acc", "voltage"]
+    assert list(acc.columns) == ["time", "base_acc", "mass_acc", "rel_acc", "voltage",
+                                 "voltage_bc"]
     assert 0.01 < acc["voltage"].std() < RIG["generator"]["voltage_sensor"]["range_V"]

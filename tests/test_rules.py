@@ -15,6 +15,7 @@ from scipy.signal import welch
 from conftest import make_study_dir, run_snakemake, small_config
 
 from harvester.data.daq import read_raw_record, to_accelerations
+from harvester.inference.posterior import pooled_log_evidence
 
 
 @pytest.fixture(scope="module")
@@ -28,8 +29,9 @@ def data_dir(study_dir):
 
 def test_dry_run_shows_the_rule_graph(study_dir):
     proc = run_snakemake(study_dir, "all", "-n")
-    for rule in ("convert", "lowpass", "static_friction", "damping_fit", "table1", "tmcmc",
-                 "evidence", "predictive", "validation_table", "headline"):
+    for rule in ("convert", "lowpass", "static_friction", "damping_fit", "table1", "identify",
+                 "evidence", "predictive", "validation_table", "headline", "prepare_recording",
+                 "group_evidence", "validate_recording", "group_validation", "diagnose"):
         assert rule in proc.stdout, rule
 
 
@@ -104,7 +106,7 @@ def test_identification_tables_and_evidence(full_dir):
         assert list(t.columns) == ["parameter", "mean", "sd", "q2.5", "q97.5", "paper", "truth"]
         assert np.all(t["q2.5"] <= t["mean"]) and np.all(t["mean"] <= t["q97.5"])
         assert np.all(t["sd"] > 0)
-    post = az.from_netcdf(full_dir / "results/posterior/tanh.nc")
+    post = az.from_netcdf(full_dir / "results/groups/paper/models/tanh/posterior.nc")
     t5 = pd.read_csv(full_dir / "results/tables/table5_tanh.csv").set_index("parameter")
     assert t5.loc["F_c", "mean"] == pytest.approx(post.posterior["F_c"].values.mean(), rel=1e-5)
     ev = pd.read_csv(full_dir / "results/tables/evidence.csv")
@@ -113,8 +115,19 @@ def test_identification_tables_and_evidence(full_dir):
     bf = pd.read_csv(full_dir / "results/tables/bayes_factor.csv")
     # the rig has friction: the tanh model must win by far
     assert bf.loc[bf.model == "tanh", "log_bayes_factor"].item() > 20
-    log = (full_dir / "logs/tmcmc_tanh.log").read_text()
+    log = (full_dir / "logs/groups/paper/identify_tanh.log").read_text()
     assert "stage" in log and "beta=" in log and "accept=" in log
+    # the study's group: its recordings are the study's low-passed records, byte for byte, and
+    # its evidence table pools the chains the study's table lists
+    for rec in ("training", "validation"):
+        assert (full_dir / f"results/groups/paper/data/{rec}.csv").read_bytes() == \
+            (full_dir / f"results/data/{rec}_filtered.csv").read_bytes()
+    group = pd.read_csv(full_dir / "results/groups/paper/evidence.csv").set_index("model")
+    for model in ("linear", "tanh"):
+        assert group.loc[model, "log_evidence"] == pytest.approx(
+            pooled_log_evidence(ev.loc[ev.model == model, "log_evidence"]), rel=1e-5)
+    assert group.loc["tanh", "log_bayes_factor"] == pytest.approx(
+        bf.loc[bf.model == "tanh", "log_bayes_factor"].item(), rel=1e-5)
 
 
 def test_validation_table_content(full_dir):
@@ -137,6 +150,21 @@ def test_validation_table_content(full_dir):
         assert (full_dir / "results/figures" / name).stat().st_size > 10_000
     head = pd.read_csv(full_dir / "results/tables/headline.csv")
     assert head.quantity.str.contains("Bayes factor").any()
+
+
+def test_the_report_has_the_paper_pages_and_a_page_per_group(full_dir):
+    report = full_dir / "report.html"
+    run_snakemake(full_dir, "--report", str(report))
+    text = report.read_text()
+    categories = json.loads(text.split("var categories = ", 1)[1].split(";\n", 1)[0])
+    assert {"Data", "Initial modelling", "Identification", "Model selection", "Validation",
+            "Recording groups"} <= set(categories)
+    page = categories["Recording groups"]["paper"]
+    for path in ("results/groups/paper/evidence.html", "results/groups/paper/validation.csv",
+                 "results/groups/paper/models/tanh/posterior_pairs.png",
+                 "results/groups/paper/validation/tanh/validation/predictive.png",
+                 "results/groups/paper/diagnosis/linear/summary.html"):
+        assert path in page, path
 
 
 @pytest.mark.parametrize("corruption, message", [

@@ -1,5 +1,6 @@
-# Raw recordings: regenerate from the seed (bit-for-bit check), verify checksums, convert volts to m/s^2
-# (and, for the loaded records, the voltage channel to load volts).
+# Recordings: the rig's raw data (regenerated from the seed and compared bit for bit, checksums
+# verified), raw DAQ volts converted to m/s^2, and every recording of the sheet prepared for its
+# group: copied with its sidecar beside it and checked as an instrument would check it.
 
 
 rule regenerate_raw_data:
@@ -32,7 +33,7 @@ rule check_raw_reproduced:
 rule verify_checksums:
     input:
         sums=config["data"]["checksums"],
-        files=[f for r in RECORDS + LOADED_RECORDS for f in raw_files(r).values()]
+        files=[f"{RAW}/{r}.{ext}" for r in RECORDS + LOADED_RECORDS for ext in ("csv", "json")]
         + [f"{RAW}/static_friction.csv", f"{RAW}/static_friction.json"],
     output:
         "results/checks/raw_checksums.txt",
@@ -45,19 +46,45 @@ rule verify_checksums:
 
 
 rule convert:
+    """Volts -> m/s^2 and z'' = x'' - y'' (a loaded record's voltage channel -> load volts):
+    the rig's records and every raw_daq recording of the sheet."""
     input:
         unpack(lambda w: raw_files(w.record)),
-        checked="results/checks/raw_checksums.txt",
     output:
         "results/data/{record}_acc.csv",
     wildcard_constraints:
-        record="|".join(RECORDS + LOADED_RECORDS),
+        record=one_of(RECORDS + LOADED_RECORDS + SHEET.recordings(kind="raw_daq")),
     log:
         "logs/convert_{record}.log",
     conda:
         ENV
     script:
         "../scripts/convert.py"
+
+
+rule prepare_recording:
+    """A recording of the sheet as its group uses it: copied with its sidecar (filtered_at_hz
+    set) beside it, checked; what the checks found in RECORDING.check.json."""
+    input:
+        unpack(prepare_inputs),
+    output:
+        csv=f"{GROUP_DIR}/data/{{recording}}.csv",
+        sidecar=f"{GROUP_DIR}/data/{{recording}}.yaml",
+        check=report(f"{GROUP_DIR}/data/{{recording}}.check.json",
+                     caption="../report/group_recording.rst", category=GROUP_PAGE,
+                     subcategory="{group}",
+                     labels=lambda w: page_labels(w.group, "0. recording", "-", w.recording)),
+    wildcard_constraints:
+        group=one_of(GENERIC_GROUPS),
+        recording=one_of(generic_recordings()),
+    params:
+        lowpass=lambda w: lowpass_settings(w.recording),
+    log:
+        "logs/groups/{group}/prepare_{recording}.log",
+    conda:
+        ENV
+    script:
+        "../scripts/prepare_recording.py"
 
 
 rule loaded_data:

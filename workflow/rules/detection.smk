@@ -57,6 +57,7 @@ rule detection_scenario:
         rig=config["rig"],
         preprocess=config["preprocess"],
         settings=lambda w: scenario_settings(),
+        generator=lambda w: detection_grid().get("generator", "library"),
     wildcard_constraints:
         **SCENARIO_WILDCARDS,
     resources:
@@ -78,6 +79,8 @@ rule diagnose_scenario:
         f"{DET}/diagnoses/{{effect}}/r{{ratio}}_s{{seed}}.json",
     params:
         fast=lambda w: bool(detection_grid()["fast"]),
+        # a grid's recordings may be unfiltered (the literature generator's): its own low-pass
+        lowpass_hz=lambda w: detection_grid().get("lowpass_hz", config["preprocess"]["lowpass_hz"]),
         preprocess=config["preprocess"],
     wildcard_constraints:
         **SCENARIO_WILDCARDS,

@@ -1,28 +1,27 @@
-# The paper's own step, automated: diagnose each identified model against the training record,
-# with the unseen record for the before/after comparison (issue: diagnosis of model discrepancy).
+# The paper's own step, automated: the diagnosis of each identified model of a group on its
+# training recording, with its first validation recording for the before/after comparison
+# (settings: config diagnosis; a group's own: config groups.<group>.diagnosis).
 
 
-rule diagnose_model:
+rule diagnose:
     input:
-        data="results/data/training_filtered.csv",
-        validation="results/data/validation_filtered.csv",
-        posterior="results/posterior/{model}.nc",
-        priors="results/initial/priors.json",
+        unpack(lambda w: diagnosis_inputs(w.group, w.model)),
     output:
-        json=report("results/diagnosis/{model}/diagnosis.json", caption="../report/diagnosis.rst",
-                    category="Diagnosis", subcategory="{model}"),
+        json=diagnosis_file("{group}", "{model}"),
+        summary=report(diagnosis_file("{group}", "{model}", "summary.html"),
+                       caption="../report/diagnosis.rst", category=GROUP_PAGE,
+                       subcategory="{group}",
+                       labels=lambda w: page_labels(w.group, "4. diagnosis", w.model)),
+    wildcard_constraints:
+        group=one_of([g for g in GENERIC_GROUPS if DIAGNOSED[g]]),
     params:
-        lead_in=config["preprocess"]["training_lead_in"],
-        samples=config["preprocess"]["training_samples"],
-        lowpass_hz=config["preprocess"]["lowpass_hz"],
-        filter_order=config["preprocess"]["filter_order"],
-        diagnosis=config["diagnosis"],
+        settings=lambda w: group_params(w.group, "diagnosis"),
     threads: 2
     resources:
         mem_mb=4000,
         runtime=60,
     log:
-        "logs/diagnose_{model}.log",
+        "logs/groups/{group}/diagnose_{model}.log",
     conda:
         ENV
     script:

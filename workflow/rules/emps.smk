@@ -1,18 +1,47 @@
-# EMPS (real recordings, Janot, Gautier and Brunot 2019): a study of its own, target emps_all.
+# EMPS (real recordings, Janot, Gautier and Brunot 2019): the chain of a sheet's EMPS group
+# (config/emps/recordings.tsv: its training and validation recordings), target emps_all.
 # The drive is simulated inside its digital position loop (harvester.emps.closed_loop); the viscous baseline
 # and baseline + each candidate term are identified by TMCMC, the evidence names the missing
 # physics, the extended model's parameters are compared with the published ones and both models
-# are validated on the unseen DATA_EMPS_PULSES record.
+# are validated on the unseen record (DATA_EMPS_PULSES). Settings: config emps.
 EMPS = config["emps"]
 EMPS_BASELINE = "viscous"
 EMPS_MODELS = [EMPS_BASELINE] + [f"viscous+{t}" for t in EMPS["candidates"]]
 EMPS_EXTENDED = f"viscous+{EMPS['extended']}"
 EMPS_SHOWN = [EMPS_BASELINE, EMPS_EXTENDED]
 EMPS_RECORDS = ["training", "validation"]
+#: The EMPS group's report page (its name in the sheet).
+EMPS_PAGE = EMPS_GROUP or "emps"
 
 
-rule emps_all:
-    input:
+def emps_file(role):
+    """The EMPS group's recording of a role (training, validation), from the sheet."""
+    if EMPS_GROUP is None:
+        raise ValueError("no EMPS group in the recording sheet(s): add config/emps/recordings.tsv "
+                         "to config recordings")
+    grp = SHEET.groups[EMPS_GROUP]
+    return SHEET.file(grp.training if role == "training" else grp.validation[0])
+
+
+def emps_name(role):
+    """The name in the sheet of the EMPS group's recording of a role (both: the two)."""
+    if role == "both":
+        return ", ".join(emps_name(r) for r in EMPS_RECORDS)
+    if EMPS_GROUP is None:
+        return role
+    grp = SHEET.groups[EMPS_GROUP]
+    return grp.training if role == "training" else grp.validation[0]
+
+
+def emps_labels(result, model="-", role=None):
+    """Columns of an EMPS result on the group's report page (as a generic group's)."""
+    return lambda w: {"result": result, "model": model,
+                      "recording": emps_name(role or w.get("record", "training"))}
+
+
+def emps_outputs():
+    """Everything the EMPS group's page shows (target emps_all)."""
+    return [
         "results/emps/data.json",
         "results/emps/figures/data.png",
         "results/emps/priors.csv",
@@ -23,22 +52,29 @@ rule emps_all:
         "results/emps/parameters_comparison.csv",
         "results/emps/figures/posterior.png",
         "results/emps/validation.csv",
-        expand("results/emps/figures/tracking_{record}{part}.png", record=EMPS_RECORDS,
-               part=["", "_zoom"]),
+        *expand("results/emps/figures/tracking_{record}{part}.png", record=EMPS_RECORDS,
+                part=["", "_zoom"]),
         "results/emps/headline.csv",
         "results/emps/headline.html",
+    ]
+
+
+rule emps_all:
+    input:
+        emps_outputs(),
 
 
 rule emps_data:
     input:
-        training=EMPS["training"],
-        validation=EMPS["validation"],
+        training=lambda w: emps_file("training"),
+        validation=lambda w: emps_file("validation"),
     output:
         summary="results/emps/data.json",
         figure=report("results/emps/figures/data.png", caption="../report/emps_data.rst",
-                      category="EMPS", subcategory="1. Data"),
+                      category=GROUP_PAGE, subcategory=EMPS_PAGE,
+                      labels=emps_labels("1. data", "-", "both")),
     params:
-        sha256=EMPS["sha256"],
+        sha256=EMPS.get("sha256", {}),
     log:
         "logs/emps/data.log",
     conda:
@@ -49,14 +85,16 @@ rule emps_data:
 
 rule emps_initial:
     input:
-        training=EMPS["training"],
+        training=lambda w: emps_file("training"),
         checked="results/emps/data.json",
     output:
         priors="results/emps/priors.json",
         table=report("results/emps/priors.csv", caption="../report/emps_priors.rst",
-                     category="EMPS", subcategory="2. Initial modelling"),
+                     category=GROUP_PAGE, subcategory=EMPS_PAGE,
+                     labels=emps_labels("2. initial modelling (priors)")),
         figure=report("results/emps/figures/frf.png", caption="../report/emps_frf.rst",
-                      category="EMPS", subcategory="2. Initial modelling"),
+                      category=GROUP_PAGE, subcategory=EMPS_PAGE,
+                      labels=emps_labels("2. initial modelling (FRF)")),
     params:
         frf=EMPS["frf"],
         priors=EMPS["priors"],
@@ -72,7 +110,7 @@ rule emps_initial:
 
 rule emps_tmcmc:
     input:
-        training=EMPS["training"],
+        training=lambda w: emps_file("training"),
         priors="results/emps/priors.json",
     output:
         "results/emps/posterior/{model}.nc",
@@ -98,10 +136,12 @@ rule emps_diagnosis:
         expand("results/emps/posterior/{model}.nc", model=EMPS_MODELS),
     output:
         table=report("results/emps/diagnosis.csv", caption="../report/emps_diagnosis.rst",
-                     category="EMPS", subcategory="3. Missing physics"),
+                     category=GROUP_PAGE, subcategory=EMPS_PAGE,
+                     labels=emps_labels("3. evidence (table)", "all")),
         named="results/emps/named_physics.json",
         figure=report("results/emps/figures/evidence.png", caption="../report/emps_evidence.rst",
-                      category="EMPS", subcategory="3. Missing physics"),
+                      category=GROUP_PAGE, subcategory=EMPS_PAGE,
+                      labels=emps_labels("3. evidence (figure)", "all")),
     params:
         models=EMPS_MODELS,
         extended=EMPS["extended"],
@@ -119,12 +159,15 @@ rule emps_parameters:
         data="results/emps/data.json",
     output:
         parameters=report("results/emps/parameters.csv", caption="../report/emps_parameters.rst",
-                          category="EMPS", subcategory="4. Parameters"),
+                          category=GROUP_PAGE, subcategory=EMPS_PAGE,
+                          labels=emps_labels("4. posterior (table)", EMPS_EXTENDED)),
         comparison=report("results/emps/parameters_comparison.csv",
-                          caption="../report/emps_comparison.rst", category="EMPS",
-                          subcategory="4. Parameters"),
+                          caption="../report/emps_comparison.rst", category=GROUP_PAGE,
+                          subcategory=EMPS_PAGE,
+                          labels=emps_labels("4. posterior (published values)", EMPS_EXTENDED)),
         figure=report("results/emps/figures/posterior.png", caption="../report/emps_posterior.rst",
-                      category="EMPS", subcategory="4. Parameters"),
+                      category=GROUP_PAGE, subcategory=EMPS_PAGE,
+                      labels=emps_labels("4. posterior (figure)", EMPS_EXTENDED)),
     log:
         "logs/emps/parameters.log",
     conda:
@@ -136,7 +179,7 @@ rule emps_parameters:
 rule emps_predictive:
     input:
         posterior="results/emps/posterior/{model}.nc",
-        record=lambda w: EMPS[w.record],
+        record=lambda w: emps_file(w.record),
         priors="results/emps/priors.json",
     output:
         band="results/emps/predictive/{model}_{record}.npz",
@@ -161,7 +204,8 @@ rule emps_validation:
                record=EMPS_RECORDS),
     output:
         report("results/emps/validation.csv", caption="../report/emps_validation.rst",
-               category="EMPS", subcategory="5. Validation"),
+               category=GROUP_PAGE, subcategory=EMPS_PAGE,
+               labels=emps_labels("5. validation (table)", ", ".join(EMPS_SHOWN), "validation")),
     log:
         "logs/emps/validation.log",
     conda:
@@ -176,11 +220,13 @@ rule emps_tracking_figure:
         metrics=expand("results/emps/predictive/{model}_{{record}}.json", model=EMPS_SHOWN),
     output:
         full=report("results/emps/figures/tracking_{record}.png",
-                    caption="../report/emps_tracking.rst", category="EMPS",
-                    subcategory="5. Validation"),
+                    caption="../report/emps_tracking.rst", category=GROUP_PAGE,
+                    subcategory=EMPS_PAGE,
+                    labels=emps_labels("5. validation (figure)", ", ".join(EMPS_SHOWN))),
         zoom=report("results/emps/figures/tracking_{record}_zoom.png",
-                    caption="../report/emps_tracking.rst", category="EMPS",
-                    subcategory="5. Validation"),
+                    caption="../report/emps_tracking.rst", category=GROUP_PAGE,
+                    subcategory=EMPS_PAGE,
+                    labels=emps_labels("5. validation (zoom)", ", ".join(EMPS_SHOWN))),
     wildcard_constraints:
         record="|".join(EMPS_RECORDS),
     params:
@@ -206,7 +252,8 @@ rule emps_headline:
     output:
         csv="results/emps/headline.csv",
         html=report("results/emps/headline.html", caption="../report/emps_headline.rst",
-                    category="EMPS", subcategory="0. Headline numbers"),
+                    category=GROUP_PAGE, subcategory=EMPS_PAGE,
+                    labels=emps_labels("0. headline", "all")),
     params:
         models=EMPS_MODELS,
         baseline=EMPS_BASELINE,

@@ -1,34 +1,64 @@
-# Bayesian identification: TMCMC per model structure, posterior tables and figures, evidence.
+# Bayesian identification: TMCMC per group and model structure, the group's evidence table;
+# the paper study's posterior tables and figures (Tables 3, 5, Figures 6, 8) and evidence
+# (eqs. 11, 12) from its group's posteriors.
 
 
-rule tmcmc:
+localrules:
+    group_evidence,
+
+
+rule identify:
     input:
-        data="results/data/training_filtered.csv",
-        priors="results/initial/priors.json",
+        data=lambda w: training_csv(w.group),
+        sidecar=lambda w: training_csv(w.group).replace(".csv", ".yaml"),
+        priors=lambda w: group_priors_file(w.group),
     output:
-        "results/posterior/{model}.nc",
+        posterior=model_file("{group}", "{model}", "posterior.nc"),
+        summary=model_file("{group}", "{model}", "summary.csv"),
+        evidence=model_file("{group}", "{model}", "evidence.json"),
+        pairs=report(model_file("{group}", "{model}", "posterior_pairs.png"),
+                     caption="../report/group_posterior.rst", category=GROUP_PAGE,
+                     subcategory="{group}",
+                     labels=lambda w: page_labels(w.group, "2. posterior", w.model)),
+    wildcard_constraints:
+        group=one_of(GENERIC_GROUPS),
     params:
-        rig=config["rig"],
-        tmcmc=config["tmcmc"],
-        lead_in=config["preprocess"]["training_lead_in"],
-        samples=config["preprocess"]["training_samples"],
-        lowpass_hz=config["preprocess"]["lowpass_hz"],
-        filter_order=config["preprocess"]["filter_order"],
+        settings=lambda w: group_params(w.group, "tmcmc"),
     threads: 2
     resources:
         mem_mb=4000,
         runtime=60,
     log:
-        "logs/tmcmc_{model}.log",
+        "logs/groups/{group}/identify_{model}.log",
     conda:
         ENV
     script:
-        "../scripts/tmcmc.py"
+        "../scripts/identify.py"
+
+
+rule group_evidence:
+    input:
+        lambda w: [model_file(w.group, m, "evidence.json") for m in group_models(w.group)],
+    output:
+        csv=f"{GROUP_DIR}/evidence.csv",
+        html=report(f"{GROUP_DIR}/evidence.html", caption="../report/group_evidence.rst",
+                    category=GROUP_PAGE, subcategory="{group}",
+                    labels=lambda w: page_labels(w.group, "1. evidence", "all")),
+    wildcard_constraints:
+        group=one_of(GENERIC_GROUPS),
+    params:
+        models=lambda w: group_models(w.group),
+    log:
+        "logs/groups/{group}/evidence.log",
+    conda:
+        ENV
+    script:
+        "../scripts/group_evidence.py"
 
 
 rule posterior_table:
     input:
-        posterior="results/posterior/{model}.nc",
+        posterior=lambda w: study_posterior(w.model),
         priors="results/initial/priors.json",
     output:
         report("results/tables/{table}_{model}.csv", caption="../report/posterior_table.rst",
@@ -47,7 +77,7 @@ rule posterior_table:
 
 rule posterior_figure:
     input:
-        posterior="results/posterior/{model}.nc",
+        posterior=lambda w: study_posterior(w.model),
     output:
         report("results/figures/{fig}_{model}_posterior.png", caption="../report/posterior_figure.rst",
                category="Identification", subcategory="{model}"),
@@ -65,7 +95,7 @@ rule posterior_figure:
 
 rule evidence:
     input:
-        expand("results/posterior/{model}.nc", model=MODELS),
+        lambda w: [study_posterior(m) for m in MODELS],
     output:
         evidence=report("results/tables/evidence.csv", caption="../report/evidence.rst",
                         category="Model selection"),

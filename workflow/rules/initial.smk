@@ -1,4 +1,5 @@
-# Initial modelling (paper section "Initial modelling"): static friction, viscous damping, Table 1, priors.
+# Initial modelling (paper section "Initial modelling"): static friction, viscous damping, Table 1,
+# priors; and the priors of any group from its training recording.
 
 
 rule static_friction:
@@ -61,3 +62,25 @@ rule table1:
         ENV
     script:
         "../scripts/table1.py"
+
+
+rule recording_priors:
+    """A group's priors from its training recording: the sidecar's priors, the recording's FRF
+    (harvester.initial.recording), the library's defaults (the paper study's group: rule
+    table1)."""
+    input:
+        data=lambda w: training_csv(w.group),
+        sidecar=lambda w: training_csv(w.group).replace(".csv", ".yaml"),
+    output:
+        f"{GROUP_DIR}/priors.json",
+    wildcard_constraints:
+        group=one_of(GENERIC_GROUPS),
+    params:
+        models=lambda w: group_models(w.group),
+        settings=lambda w: group_params(w.group),
+    log:
+        "logs/groups/{group}/recording_priors.log",
+    conda:
+        ENV
+    script:
+        "../scripts/recording_priors.py"

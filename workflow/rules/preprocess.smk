@@ -1,14 +1,17 @@
-# Zero-phase low-pass filtering (paper: 20 Hz) and Figures 4 and 5.
+# Zero-phase low-pass filtering of the measured output (paper: 20 Hz; a group's: config
+# groups.<group>.lowpass_hz) and the paper's Figures 4 and 5.
 
 
 rule lowpass:
     input:
-        "results/data/{record}_acc.csv",
+        lambda w: converted_file(w.record),
     output:
         "results/data/{record}_filtered.csv",
+    wildcard_constraints:
+        record=one_of(RECORDS + [r for r in generic_recordings() if lowpass_settings(r)[0]]),
     params:
-        cutoff=config["preprocess"]["lowpass_hz"],
-        order=config["preprocess"]["filter_order"],
+        cutoff=lambda w: lowpass_settings(w.record)[0],
+        order=lambda w: lowpass_settings(w.record)[1],
     log:
         "logs/lowpass_{record}.log",
     conda:

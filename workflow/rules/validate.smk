@@ -1,9 +1,65 @@
-# Posterior predictive on training and unseen data: Figures 7, 9, 10 and validation metrics.
+# Unseen-data validation: the posterior predictive of every model of a group on each of its
+# validation recordings; the paper study's on its training and unseen records (Figures 7, 9, 10
+# and its validation metrics).
+
+
+localrules:
+    group_validation,
+
+
+rule validate_recording:
+    input:
+        posterior=lambda w: group_posterior(w.group, w.model),
+        data=lambda w: recording_csv(w.group, w.recording),
+        sidecar=lambda w: recording_csv(w.group, w.recording).replace(".csv", ".yaml"),
+    output:
+        band=f"{GROUP_DIR}/validation/{{model}}/{{recording}}/predictive.csv",
+        metrics=f"{GROUP_DIR}/validation/{{model}}/{{recording}}/validation.json",
+        figure=report(f"{GROUP_DIR}/validation/{{model}}/{{recording}}/predictive.png",
+                      caption="../report/group_validation.rst", category=GROUP_PAGE,
+                      subcategory="{group}",
+                      labels=lambda w: page_labels(w.group, "3. validation", w.model,
+                                                   w.recording)),
+    wildcard_constraints:
+        group=one_of(GENERIC_GROUPS),
+        recording=one_of(generic_recordings()),
+    params:
+        predictive=lambda w: GROUPS[w.group]["predictive"],
+        lead_in_s=lambda w: GROUPS[w.group]["validation_lead_in_s"],
+    threads: 2
+    resources:
+        mem_mb=4000,
+        runtime=30,
+    log:
+        "logs/groups/{group}/validate_{model}_{recording}.log",
+    conda:
+        ENV
+    script:
+        "../scripts/validate_recording.py"
+
+
+rule group_validation:
+    input:
+        lambda w: [f"{validation_dir(w.group, m, r)}/validation.json" for m in group_models(w.group)
+                   for r in SHEET.groups[w.group].validation],
+    output:
+        report(f"{GROUP_DIR}/validation.csv", caption="../report/group_validation_table.rst",
+               category=GROUP_PAGE, subcategory="{group}",
+               labels=lambda w: page_labels(w.group, "3. validation", "all",
+                                            ", ".join(SHEET.groups[w.group].validation) or "-")),
+    wildcard_constraints:
+        group=one_of(GENERIC_GROUPS),
+    log:
+        "logs/groups/{group}/validation.log",
+    conda:
+        ENV
+    script:
+        "../scripts/group_validation.py"
 
 
 rule predictive:
     input:
-        posterior="results/posterior/{model}.nc",
+        posterior=lambda w: study_posterior(w.model),
         data="results/data/{record}_filtered.csv",
         priors="results/initial/priors.json",
     output:

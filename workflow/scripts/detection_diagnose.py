@@ -16,7 +16,7 @@ with rule_log(snakemake) as log:  # noqa: F821
     result = run_diagnosis(recording, truth["baseline"], truth["known"],
                            seed=int(sm.wildcards.seed), fast=sm.params.fast,
                            lead_in=int(round(truth["settings"]["lead_in_s"] * fs)),
-                           lowpass_hz=sm.params.preprocess["lowpass_hz"],
+                           lowpass_hz=sm.params.lowpass_hz,
                            filter_order=sm.params.preprocess["filter_order"])
     result["scenario"] = {k: truth[k] for k in ("effect", "ratio", "seed", "baseline")}
     write_json(result, sm.output[0])

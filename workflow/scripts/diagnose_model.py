@@ -1,22 +1,19 @@
-"""Rule diagnose_model: the diagnosis of one identified model on the study's training record."""
+"""Rule diagnose: the diagnosis of one identified model of a group on its training recording
+(diagnosis.json, its figures, and a summary for the report)."""
 
-import arviz as az
+from pathlib import Path
 
-from harvester.data.daq import read_recording
-from harvester.diagnosis.run import DiagnosisSettings, diagnose_study
-from harvester.data.fileio import read_json
-from harvester.inference.priors import PriorSpec
+from harvester.data.fileio import atomic_path, read_json
+from harvester.groups import diagnose_model, diagnosis_html
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821
     sm = snakemake  # noqa: F821
-    prior_file = read_json(sm.input.priors)
-    priors = {n: PriorSpec(**p) for n, p in prior_file["priors"].items()}
-    settings = DiagnosisSettings(**sm.params.diagnosis, lowpass_hz=sm.params.lowpass_hz,
-                                 filter_order=sm.params.filter_order)
-    diag = diagnose_study(read_recording(sm.input.data), sm.wildcards.model, prior_file["known"],
-                          priors, read_recording(sm.input.validation), settings,
-                          out_dir=sm.output.json.rsplit("/", 1)[0],
-                          posterior=az.from_netcdf(sm.input.posterior),
-                          lead_in=sm.params.lead_in, samples=sm.params.samples)
+    diag = diagnose_model(sm.input.data, sm.input.get("validation"), sm.input.posterior,
+                          sm.input.priors, sm.wildcards.model, sm.params.settings,
+                          Path(sm.output.json).parent)
+    with atomic_path(sm.output.summary) as tmp:
+        tmp.write_text(diagnosis_html(read_json(sm.output.json),
+                                      f"Diagnosis of {sm.wildcards.model}, group "
+                                      f"{sm.wildcards.group}"))
     log.info("verdict %s, missing %s", diag.verdict, diag.missing)

@@ -7,7 +7,7 @@ from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821
     sm = snakemake  # noqa: F821
-    records = {role: emps.load_emps(sm.input[role], sm.params.sha256[role])
+    records = {role: emps.load_emps(sm.input[role], sm.params.sha256.get(role))
                for role in ("training", "validation")}
     out = {}
     for role, rec in records.items():

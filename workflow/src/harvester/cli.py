@@ -6,6 +6,7 @@
     harvester predict  REC --posterior DIR/posterior.nc --out DIR2
     harvester diagnose REC --baseline tanh --out DIR
     harvester terms                                        the physics library
+    harvester power    EXC.csv --electrical results/electrical --out DIR   power vs load
 
 A recording is read and checked once (``harvester.data.daq.read_checked_recording``, the
 checks of ``harvester.data.checks``, the sidecar of ``harvester.data.sidecar``), ``--out`` is
@@ -66,7 +67,63 @@ def _model_expression(text: str) -> str:
     return text
 
 
-def _command(sub, name: str, help_: str, example: str, outputs: str) -> argparse.ArgumentParser:
+def _term_name(text: str) -> str:
+    """argparse type: the name of a physics term of the library."""
+    from harvester.model.terms import term
+    try:
+        term(text)
+    except KeyError as err:
+        raise argparse.ArgumentTypeError(str(err.args[0])) from None
+    return text
+
+
+#: Each command's help, example and what it writes (its --help).
+COMMAND_TEXTS: dict[str, tuple[str, str, str]] = {
+    "check": ("check a recording as an instrument would, and nothing else",
+              "harvester check rec.csv",
+              "prints the recording's kinds, rate, duration, device parameters and every "
+              "warning with its evidence"),
+    "identify": ("identify one model structure by TMCMC",
+                 "harvester identify rec.csv --model tanh+cubic_stiffness --out fit",
+                 "writes DIR/posterior.nc, summary.csv (parameter, unit, mean, sd, 2.5 and 97.5 "
+                 "%), evidence.json (log evidence in nats per chain, pooled, standard error), "
+                 "posterior_pairs.png, run.json (known, assumed, priors, warnings)"),
+    "compare": ("identify several structures; evidence and Bayes factors",
+                "harvester compare rec.csv --models linear tanh --out cmp",
+                "writes DIR/evidence.csv (model, log evidence and standard error in nats, log "
+                "Bayes factor against the first model and its error), DIR/models/<model>/ "
+                "as identify writes, run.json"),
+    "predict": ("posterior predictive on an unseen recording",
+                "harvester predict unseen.csv --posterior fit/posterior.nc --out pred",
+                "writes DIR/predictive.csv (time s, measured, mean, lower_3sd, upper_3sd, "
+                "sd_parameter, in the output's unit), validation.json (NRMSE, shares outside "
+                "+-1, 2, 3 sd, mean log predictive density in nats), predictive.png, run.json."
+                " The device's parameters are the posterior's."),
+    "diagnose": ("diagnose physics missing from a baseline model",
+                 "harvester diagnose rec.csv --baseline tanh --out diag",
+                 "writes DIR/diagnosis.json (verdict, missing effects, candidates' log "
+                 "evidence in nats, where the mismatch lies, the fit before and after; "
+                 "notes: warnings and assumptions) and figures. Needs base_acc and rel_acc, and "
+                 "M, m, k (sidecar or --paper-device)."),
+    "terms": ("list the physics library: terms, equations, units, priors", "harvester terms",
+              "prints the base equation and every term"),
+    "power": ("power the harvester would make on your base acceleration, per load, with its "
+              "uncertainty",
+              "harvester power boat.csv --electrical results/electrical --out power",
+              "EXC.csv: columns time (s, uniform) and base_acc (m/s^2). --electrical: the "
+              "directory of the study's rules electrical_identify and electrical_evidence "
+              "(weights.json, samples_<structure>.csv). Writes DIR/curve.csv (per load in ohm: "
+              "mean, median, interval and low quantile of the mean power in W, also with the "
+              "friction scaled by --friction-factor; with --record also one record's "
+              "interval), energy.csv (J over a record), "
+              "design.json (the loads of maximum expected power and of maximum low quantile, "
+              "the paired gain of the change), power_vs_load.png, energy.png, run.json"),
+}
+
+
+def _command(sub, name: str) -> argparse.ArgumentParser:
+    """The sub-parser of a command, with its texts from :data:`COMMAND_TEXTS`."""
+    help_, example, outputs = COMMAND_TEXTS[name]
     return sub.add_parser(name, help=help_, description=help_,
                           formatter_class=argparse.RawDescriptionHelpFormatter,
                           epilog=f"example:\n  {example}\n\n{outputs}\n\n{RECORDING_HELP}")
@@ -108,42 +165,49 @@ def _parser() -> argparse.ArgumentParser:
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
                                 epilog=RECORDING_HELP)
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    c = _command(sub, "check", "check a recording as an instrument would, and nothing else",
-                 "harvester check rec.csv", "prints the recording's kinds, rate, duration, "
-                 "device parameters and every warning with its evidence")
-    _recording_args(c, out=False)
-    i = _command(sub, "identify", "identify one model structure by TMCMC",
-                 "harvester identify rec.csv --model tanh+cubic_stiffness --out fit",
-                 "writes DIR/posterior.nc, summary.csv (parameter, unit, mean, sd, 2.5 and 97.5 "
-                 "%), evidence.json (log evidence in nats per chain, pooled, standard error), "
-                 "posterior_pairs.png, run.json (known, assumed, priors, warnings)")
+    _recording_args(_command(sub, "check"), out=False)
+    i = _command(sub, "identify")
     _recording_args(i)
     i.add_argument("--model", type=_model_expression, required=True, metavar="EXPR",
                    help="base+term+..., e.g. tanh+cubic_stiffness (harvester terms lists them)")
     _fit_args(i)
-    c = _command(sub, "compare", "identify several structures; evidence and Bayes factors",
-                 "harvester compare rec.csv --models linear tanh --out cmp",
-                 "writes DIR/evidence.csv (model, log evidence and standard error in nats, log "
-                 "Bayes factor against the first model and its error), DIR/models/<model>/ "
-                 "as identify writes, run.json")
+    c = _command(sub, "compare")
     _recording_args(c)
     c.add_argument("--models", type=_model_expression, nargs="+", required=True,
                    metavar="EXPR", help="model expressions; Bayes factors against the first")
     _fit_args(c)
     _predict_parser(sub)
     _diagnose_parser(sub)
-    _command(sub, "terms", "list the physics library: terms, equations, units, priors",
-             "harvester terms", "prints the base equation and every term")
+    _command(sub, "terms")
+    _power_parser(sub)
     return p
 
 
+def _power_parser(sub) -> None:
+    w = _command(sub, "power")
+    w.add_argument("excitation", type=Path, help="base acceleration CSV (time, base_acc)")
+    w.add_argument("--electrical", type=Path, required=True, metavar="DIR",
+                   help="weights.json and samples_<structure>.csv of the electrical study")
+    w.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory")
+    w.add_argument("--loads", type=float, nargs=3, default=(0.25, 25.0, 13),
+                   metavar=("MIN", "MAX", "COUNT"), help="geometric grid of loads, ohm")
+    w.add_argument("--draws", type=int, default=150, help="posterior draws (150)")
+    w.add_argument("--seed", type=int, default=0, help="random seed of the draws (0)")
+    w.add_argument("--lead-in", type=float, default=2.0, metavar="S",
+                   help="seconds left out of the mean power (2.0; the model starts at rest)")
+    w.add_argument("--record", type=float, default=None, metavar="S",
+                   help="cut the excitation into records of S seconds: their spread joins the "
+                        "parameters' (default: one record)")
+    w.add_argument("--interval", type=float, default=0.9, help="credible interval (0.9)")
+    w.add_argument("--low-quantile", type=float, default=0.05, help="cautious quantile (0.05)")
+    w.add_argument("--friction-factor", type=float, default=0.5,
+                   help="the change whose gain is predicted: F_c times this (0.5)")
+    w.add_argument("--no-figures", action="store_true", help="write no figure")
+    w.add_argument("--log", type=Path, metavar="FILE", help="progress to FILE, not stderr")
+
+
 def _predict_parser(sub) -> None:
-    d = _command(sub, "predict", "posterior predictive on an unseen recording",
-                 "harvester predict unseen.csv --posterior fit/posterior.nc --out pred",
-                 "writes DIR/predictive.csv (time s, measured, mean, lower_3sd, upper_3sd, "
-                 "sd_parameter, in the output's unit), validation.json (NRMSE, shares outside "
-                 "+-1, 2, 3 sd, mean log predictive density in nats), predictive.png, run.json."
-                 " The device's parameters are the posterior's.")
+    d = _command(sub, "predict")
     _recording_args(d, paper_device=False)
     d.add_argument("--posterior", type=Path, required=True, metavar="P.nc",
                    help="posterior.nc written by harvester identify (same device and kinds)")
@@ -155,12 +219,7 @@ def _predict_parser(sub) -> None:
 
 
 def _diagnose_parser(sub) -> None:
-    d = _command(sub, "diagnose", "diagnose physics missing from a baseline model",
-                 "harvester diagnose rec.csv --baseline tanh --out diag",
-                 "writes DIR/diagnosis.json (verdict, missing effects, candidates' log "
-                 "evidence in nats, where the mismatch lies, the fit before and after; "
-                 "notes: warnings and assumptions) and figures. Needs base_acc and rel_acc, and "
-                 "M, m, k (sidecar or --paper-device).")
+    d = _command(sub, "diagnose")
     _recording_args(d)
     d.add_argument("--baseline", type=_model_expression, required=True, metavar="EXPR",
                    help="model to diagnose: any expression, e.g. linear, tanh, "
@@ -181,6 +240,9 @@ def _diagnose_parser(sub) -> None:
     d.add_argument("--chains", type=int, default=2, help="TMCMC chains (2)")
     d.add_argument("--rounds", type=int, help="most effects added in turn (2; fast: 1)")
     d.add_argument("--top", type=int, help="candidates sampled per round (3; fast: 2)")
+    d.add_argument("--candidates", nargs="+", metavar="TERM", type=_term_name,
+                   help="library terms considered as missing (default: every term; "
+                        "`harvester terms` lists them)")
     d.add_argument("--fast", action="store_true", help="cheaper settings (for grids)")
     d.add_argument("--no-figures", action="store_true", help="write diagnosis.json only")
 
@@ -404,6 +466,8 @@ def _diagnosis_settings(args: argparse.Namespace, lowpass: float | None):
     _quiet_pymc()
     overrides = {k: v for k, v in {"particles": args.particles, "rounds": args.rounds,
                                    "top": args.top}.items() if v is not None}
+    if args.candidates:
+        overrides["candidates"] = tuple(args.candidates)
     overrides.update(chains=args.chains, seed=args.seed, lowpass_hz=lowpass,
                      filter_order=args.filter_order, figures=not args.no_figures)
     return DiagnosisSettings.fast(**overrides) if args.fast else DiagnosisSettings(**overrides)
@@ -467,8 +531,42 @@ def terms_command(args: argparse.Namespace) -> int:
     return 0
 
 
+def power_command(args: argparse.Namespace) -> int:
+    from harvester.data.fileio import atomic_directory, check_output_dir, run_key, write_json
+    from harvester.power.excitations import read_excitation
+    from harvester.power.run import load_posteriors, power_study, write_power_study
+    check_output_dir(args.out, inputs=(args.excitation,))
+    samples = sorted(args.electrical.glob("samples_*.csv"))
+    weights = args.electrical / "weights.json"
+    if not samples or not weights.is_file():
+        raise DataError(args.electrical, "expected weights.json and samples_<structure>.csv "
+                        "(rules electrical_identify and electrical_evidence)")
+    try:
+        exc = read_excitation(args.excitation)
+    except ValueError as err:
+        raise DataError(args.excitation, str(err)) from None
+    cfg = {"seed": args.seed, "draws": args.draws, "lead_in_s": args.lead_in,
+           "record_s": args.record,
+           "loads": dict(zip(("min_ohm", "max_ohm", "count"), args.loads)),
+           "interval": args.interval, "low_quantile": args.low_quantile,
+           "change": {"F_c": args.friction_factor}}
+    key = run_key(args.excitation, weights, *samples,
+                  {k: str(v) for k, v in vars(args).items() if k not in ("out", "log")})
+    with atomic_directory(args.out, key) as stage:
+        study = power_study(*load_posteriors(samples, weights), exc, cfg)
+        files = write_power_study(study, stage, cfg, not args.no_figures)
+        write_json({"command": "power", "excitation": str(args.excitation), "settings": cfg,
+                    "files": files}, stage / "run.json")
+    best = study["design"]["optimum"]
+    print(f"{exc.name}: best load {best['expected']['load_ohm']:.3g} ohm "
+          f"({1e3 * best['expected']['power_W']:.3g} mW expected); cautious "
+          f"{best['low_quantile']['load_ohm']:.3g} ohm -> {args.out}")
+    return 0
+
+
 COMMANDS = {"check": check_command, "identify": identify_command, "compare": compare_command,
-            "predict": predict_command, "diagnose": diagnose_command, "terms": terms_command}
+            "predict": predict_command, "diagnose": diagnose_command, "terms": terms_command,
+            "power": power_command}
 
 
 def main(argv: list[str] | None = None) -> int:

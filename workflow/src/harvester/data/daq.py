@@ -8,10 +8,10 @@ Raw record (a DAQ export; ours are SIMULATED by ``harvester.synthetic.rig``):
   (``base_acceleration`` or ``mass_acceleration``), ``unit`` ``V``,
   ``sensitivity_mV_per_g``, ``zero_g_V``, ``range_g``, ``gravity_g``), ``seed``,
   ``generated_by``.
-* Loaded records (``harvester.synthetic.electrical``, :func:`loaded_record_metadata`) add a
-  third channel ``ai2``, quantity ``load_voltage``: the voltage between generator terminals a
-  and b through a voltage sensor (``gain_V_per_V``, ``zero_V``, ``range_V`` in load volts,
-  ``between``), and a ``load`` block (``resistance_ohm`` per resistor of the star, null in open
+* Loaded records (``harvester.synthetic.electrical``, :func:`loaded_record_metadata`) add
+  channels ``ai2`` and ``ai3``, quantity ``load_voltage``: the line voltages between generator
+  terminals a and b, and b and c, each through a voltage sensor (``gain_V_per_V``, ``zero_V``,
+  ``range_V`` in load volts, ``terminals``, ``between``), and a ``load`` block (``resistance_ohm`` per resistor of the star, null in open
   circuit) and a ``generator`` block (nameplate data; the constants to identify are withheld).
 
 Static friction test (eqs. 4-5): ``static_friction.csv`` with ``repeat,direction,position_m``
@@ -21,7 +21,8 @@ Converted recording (also the input of ``harvester diagnose``): CSV with ``time`
 one input column, ``base_acc`` (y'', m/s^2) or ``force`` (N), and one output column,
 ``rel_acc`` (z'' = x'' - y'', eq. 1, m/s^2) or ``rel_disp`` (z, m), plus optional extra numeric
 columns. The column names declare the kinds (``harvester.data.recording``); the virtual rig's
-recordings are ``time, base_acc, rel_acc``, with ``voltage`` (V) from a loaded record.
+recordings are ``time, base_acc, rel_acc``, with ``voltage`` and ``voltage_bc`` (V) from a
+loaded record.
 
 Every reader raises :class:`~harvester.data.errors.DataError` naming the file, the 1-based line
 (the header is line 1) and the column. Every writer is atomic (temporary file + rename).
@@ -70,8 +71,9 @@ SOURCE = ("virtual rig (harvester.synthetic.rig): SIMULATED recording, not data 
 GENERATED_BY = "workflow/scripts/make_raw_data.py (harvester.synthetic.rig, harvester.data.daq)"
 _CHANNEL_KEYS = ("name", "quantity", "unit", "sensitivity_mV_per_g", "zero_g_V", "range_g",
                  "gravity_g")
-#: The voltage channel of a loaded record, its quantity and its keys.
+#: The voltage channels of a loaded record (line-to-line, terminals), their quantity and keys.
 VOLTAGE_CHANNEL = "ai2"
+VOLTAGE_CHANNELS = {"ai2": ("a", "b"), "ai3": ("b", "c")}
 VOLTAGE_QUANTITY = "load_voltage"
 _VOLTAGE_KEYS = ("name", "quantity", "unit", "gain_V_per_V", "zero_V", "range_V")
 GENERATED_BY_LOADED = ("workflow/scripts/make_raw_data.py (harvester.synthetic.electrical, "
@@ -114,8 +116,8 @@ def record_metadata(rig: Mapping[str, Any], record: str, n_samples: int,
 
 def loaded_record_metadata(rig: Mapping[str, Any], record: str, n_samples: int, seed: int,
                            load_ohm: float | None) -> dict[str, Any]:
-    """Metadata of a simulated loaded record: :func:`record_metadata` plus the voltage channel
-    ``ai2``, the load (``None``: open circuit) and the generator's nameplate data.
+    """Metadata of a simulated loaded record: :func:`record_metadata` plus the voltage channels
+    ``ai2`` (v_ab) and ``ai3`` (v_bc), the load (``None``: open circuit) and the generator's nameplate data.
 
     The generator's constants (K_e, R_s, L_s) are not recorded: they are what a loaded record
     identifies, and they are ASSUMED values of the virtual rig (``rig.generator`` in the
@@ -126,13 +128,14 @@ def loaded_record_metadata(rig: Mapping[str, Any], record: str, n_samples: int, 
     meta = record_metadata(rig, record, n_samples, seed)
     meta["source"] = SOURCE.replace("harvester.synthetic.rig",
                                     "harvester.synthetic.rig + harvester.synthetic.electrical")
-    meta["channels"].append({
-        "name": VOLTAGE_CHANNEL, "quantity": VOLTAGE_QUANTITY, "unit": "V",
-        "gain_V_per_V": float(sensor["gain_V_per_V"]), "zero_V": float(sensor["zero_V"]),
-        "range_V": float(sensor["range_V"]),
-        "between": "generator terminals a and b (line-to-line): across the two star-connected "
-                   "load resistors of phases a and b in series; load voltage = "
-                   "(V - zero_V) / gain_V_per_V"})
+    for name, (one, two) in VOLTAGE_CHANNELS.items():
+        meta["channels"].append({
+            "name": name, "quantity": VOLTAGE_QUANTITY, "unit": "V",
+            "gain_V_per_V": float(sensor["gain_V_per_V"]), "zero_V": float(sensor["zero_V"]),
+            "range_V": float(sensor["range_V"]), "terminals": one + two,
+            "between": f"generator terminals {one} and {two} (line-to-line): across the two "
+                       f"star-connected load resistors of phases {one} and {two} in series; "
+                       "load voltage = (V - zero_V) / gain_V_per_V"})
     meta["load"] = {
         "connection": "three equal resistors in star on the generator terminals "
                       "(Green et al. 2015, Figure 2)",
@@ -453,14 +456,16 @@ def to_accelerations(df: pd.DataFrame, meta: Mapping[str, Any]) -> pd.DataFrame:
     """Volts to m/s^2: a = g (V - zero_g_V) / (sensitivity / 1000) - gravity_g g.
 
     Returns time, base_acc (y''), mass_acc (x'') and rel_acc = mass_acc - base_acc (z''),
-    and from a loaded record's voltage channel ``voltage`` = (V - zero_V) / gain_V_per_V, the
-    load voltage in volts (an extra column).
+    and from a loaded record's voltage channels ``voltage`` (terminals a-b) and ``voltage_bc``
+    (b-c) = (V - zero_V) / gain_V_per_V, the line voltages in volts (extra columns).
     """
     out = {"time": df["time"].to_numpy(dtype=float)}
     for ch in meta["channels"]:
         v = df[ch["name"]].to_numpy(dtype=float)
         if ch["quantity"] == VOLTAGE_QUANTITY:
-            out["voltage"] = (v - ch["zero_V"]) / ch["gain_V_per_V"]
+            terminals = ch.get("terminals", "ab")
+            column = "voltage" if terminals == "ab" else f"voltage_{terminals}"
+            out[column] = (v - ch["zero_V"]) / ch["gain_V_per_V"]
             continue
         acc = G * (v - ch["zero_g_V"]) / (ch["sensitivity_mV_per_g"] / 1000.0) \
             - ch["gravity_g"] * G
@@ -471,8 +476,8 @@ def to_accelerations(df: pd.DataFrame, meta: Mapping[str, Any]) -> pd.DataFrame:
                         "needs one base_acceleration and one mass_acceleration channel")
     frame = pd.DataFrame(out, columns=["time", "base_acc", "mass_acc"])
     frame["rel_acc"] = frame["mass_acc"] - frame["base_acc"]
-    if "voltage" in out:
-        frame["voltage"] = out["voltage"]
+    for column in sorted(c for c in out if c.startswith("voltage")):
+        frame[column] = out[column]
     return frame
 
 

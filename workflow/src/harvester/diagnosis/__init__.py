@@ -5,11 +5,14 @@ fit improve.
 Entry points: :func:`diagnose` (one recording), :func:`diagnose_study` (the study's rule),
 :func:`quick_detect` (detection and location only, MAP baseline, seconds),
 :class:`DiagnosisSettings` (``DiagnosisSettings.fast()`` for grids). Modules, in the order the
-diagnosis runs: ``baseline`` (likelihood through the measurement chain, MAP, sensitivities),
-``spectral`` (frame, noise spectrum, replicates), ``signatures`` (candidate effects' output
-signatures), ``detect`` (calibrated score tests, prior conflicts), ``locate`` (time windows,
-state regions, frequency bands), ``rank``, ``confirm`` (TMCMC, evidence), ``report``
-(unseen-data fit, diagnosis.json), ``figures``, ``synthetic`` (recordings for calibration).
+diagnosis runs: ``settings``; ``analysis`` (the recording cut into windows, the baseline's
+start); ``baseline`` (likelihood through the measurement chain, MAP, sensitivities);
+``spectral`` (frame, noise spectrum, replicates); ``signatures`` (candidate effects' output
+signatures); ``detect`` (calibrated score tests, prior conflicts); ``locate`` (time windows,
+state regions, frequency bands); ``rank``; ``confirm`` (TMCMC, evidence, ties); ``rounds``
+(detect -> rank -> confirm, one effect at a time); ``verdict`` (what is named, what is
+tied); ``separate`` (experiments that would break a tie); ``report`` (unseen-data fit,
+diagnosis.json); ``figures``; ``run`` (the orchestrator).
 """
 
 from harvester.diagnosis.run import (Diagnosis, DiagnosisSettings, check_recording, diagnose,

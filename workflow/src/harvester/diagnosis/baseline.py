@@ -194,6 +194,11 @@ class PriorCoordinates:
         high = np.array([(s.bounds[1] - s.center) / s.scale for s in self.specs])
         return low, high
 
+    def u(self, theta: np.ndarray) -> np.ndarray:
+        """Prior coordinates of one parameter vector (the free physical parameters)."""
+        return np.array([(s.to_coordinate(x) - s.center) / s.scale
+                         for x, s in zip(np.asarray(theta, dtype=float), self.specs)])
+
     def theta(self, u: np.ndarray) -> np.ndarray:
         """Parameter values of rows of u."""
         g = self.center + np.atleast_2d(u) * self.scale
@@ -207,14 +212,15 @@ class PriorCoordinates:
 
 
 def fit_map(problem: ChainProblem, priors: Mapping[str, PriorSpec], n_starts: int = 48,
-            seed: int = 0) -> PointFit:
+            seed: int = 0, start: np.ndarray | None = None) -> PointFit:
     """Posterior mode of the free physical parameters, sigma profiled (sigma = RMS residual).
 
     Minimises lambda n/2 log(sum r^2) + 1/2 sum_j w_j u_j^2 over u within the priors' bounds
     (u the prior coordinates, :class:`PriorCoordinates`; w_j = 0 for a flat prior; lambda =
     ``problem.temper``, r through the measurement chain), by trust-region least squares,
-    started from the best of ``n_starts`` prior draws (and the prior's centre) evaluated in one
-    batched simulation. Jacobians by forward differences, one batched simulation each.
+    started from the best of ``n_starts`` prior draws, the prior's centre and ``start`` (free
+    physical parameters, optional) evaluated in one batched simulation. Jacobians by forward
+    differences, one batched simulation each.
     """
     coords = PriorCoordinates.of(problem, priors)
     w = coords.penalty
@@ -233,13 +239,15 @@ def fit_map(problem: ChainProblem, priors: Mapping[str, PriorSpec], n_starts: in
                                                                                   axis=1)
         return np.where(np.isfinite(val), val, np.inf)
 
-    u0 = _best_start(coords, n_starts, seed, objective_rows)
+    extra = None if start is None else coords.u(start)
+    u0 = _best_start(coords, n_starts, seed, objective_rows, extra)
     u = _least_squares(resid_u, u0, coords, temper, n)
     return _point_fit(problem, coords, u, resid_u, temper, n, count)
 
 
-def _best_start(coords: PriorCoordinates, n_starts: int, seed: int, objective) -> np.ndarray:
-    """The best of the prior's centre and ``n_starts`` draws from the priors (in u)."""
+def _best_start(coords: PriorCoordinates, n_starts: int, seed: int, objective,
+                extra: np.ndarray | None = None) -> np.ndarray:
+    """The best of the prior's centre, ``n_starts`` draws from the priors and ``extra`` (u)."""
     low, high = coords.bounds()
     rng = np.random.default_rng(seed)
     p = len(low)
@@ -248,7 +256,10 @@ def _best_start(coords: PriorCoordinates, n_starts: int, seed: int, objective) -
     draws[:, flat] = rng.uniform(np.maximum(low, -3.0), np.minimum(high, 3.0),
                                  (n_starts, p))[:, flat]
     inside = lambda x: np.clip(x, low + 1e-6, high - 1e-6)  # noqa: E731
-    candidates = np.vstack([inside(np.zeros(p)), inside(draws)])
+    rows = [inside(np.zeros(p)), inside(draws)]
+    if extra is not None and np.all(np.isfinite(extra)):
+        rows.append(inside(extra)[None, :])
+    candidates = np.vstack(rows)
     return candidates[int(np.argmin(objective(candidates)))]
 
 

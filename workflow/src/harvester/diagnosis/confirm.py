@@ -11,9 +11,10 @@ E[B] = 1 (over the baseline's prior predictive), so P(B > 1/alpha) <= alpha (Mar
 inequality): a candidate is accepted when delta log evidence exceeds log(1/alpha) (3.0 nats at
 alpha = 0.05) plus ``mc_sigmas`` Monte Carlo standard errors of the difference. Each evidence
 is TMCMC's re-estimated by bridge sampling from the final population (``bridge_evidence``),
-whose standard error is its own; TMCMC's chains alone scatter by several nats at the
-diagnosis's particle counts. Candidates whose evidences lie within ``indistinguishable_nats``
-(or the Monte Carlo error) of the best accepted one are reported as indistinguishable.
+whose standard error is its own; chains that disagree by more than ``agreement_nats`` are
+sampled again with twice the particles. Naming (``mark_ties``): the best accepted candidate is
+named only if every physically different rival trails it by more than the acceptance
+threshold plus its Monte Carlo margin; otherwise they are reported together as a tie.
 
 Priors of the added terms: each parameter's prior as its term file states it, in the
 device's own scales (``harvester.model.priors``: the damping force the motion shows, its RMS
@@ -48,11 +49,11 @@ import arviz as az
 import numpy as np
 
 from harvester.diagnosis.baseline import ChainProblem, chain_problem
-from harvester.diagnosis.detect import Detection
+from harvester.diagnosis.detect import Detection, at_prior_edge
 from harvester.model.priors import DeviceScale
 from harvester.inference.evidence import BridgeEstimate, chains_bridge_log_evidence, log_target
 from harvester.inference.identify import TMCMCSettings, identify, posterior_theta
-from harvester.model.terms import term
+from harvester.model.terms import same_physics, term
 from harvester.inference.posterior import pooled_log_evidence
 from harvester.inference.priors import PriorSpec
 from harvester.inference.priors import priors_for
@@ -108,7 +109,6 @@ class ConfirmSettings:
     enlargements: int = 2
     alpha: float = 0.05
     mc_sigmas: float = 2.0
-    indistinguishable_nats: float = 2.0
     bridge: bool = True
     reference: bool = True
 
@@ -226,6 +226,21 @@ class CandidateResult:
     threshold: float
     accepted: bool
     indistinguishable_from: list[str] = field(default_factory=list)
+    #: added parameters whose posterior piles against a bound of their prior ('lower'/'upper')
+    at_prior_edge: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def named(self) -> bool:
+        """Accepted and no physically different candidate within the acceptance threshold."""
+        return self.accepted and not self.indistinguishable_from
+
+    def implies(self) -> str:
+        """What the effect would mean physically: the term and its added parameters."""
+        summ = self.fit.summary()
+        units = {p.name: p.unit for p in term(self.effect).parameters}
+        parts = [f"{n} {summ[n]['mean']:.3g} +- {summ[n]['sd']:.2g} {units[n]}".rstrip()
+                 for n in term(self.effect).parameter_names if n in summ]
+        return f"{term(self.effect).description}: " + ", ".join(parts)
 
     def to_dict(self) -> dict:
         added = term(self.effect).parameter_names
@@ -234,10 +249,19 @@ class CandidateResult:
                 **self.fit.evidence_dict(),
                 "delta_log_evidence": self.delta_log_evidence,
                 "delta_log_evidence_se": self.delta_se, "threshold": self.threshold,
-                "accepted": self.accepted,
+                "accepted": self.accepted, "named": self.named,
                 "indistinguishable_from": self.indistinguishable_from,
+                "at_prior_edge": self.at_prior_edge, "implies": self.implies(),
                 "parameters": summ,
-                "added_parameters": {n: summ[n] for n in added if n in summ}}
+                "added_parameters": {n: summ[n] for n in added if n in summ},
+                "added_priors": {n: prior_dict(self.fit.priors[n]) for n in added
+                                 if n in self.fit.priors}}
+
+
+def prior_dict(spec: PriorSpec) -> dict:
+    """A prior as diagnosis.json gives it."""
+    return {"family": spec.family, "mean": spec.mean, "sd": spec.sd, "lower": spec.lower,
+            "upper": spec.upper, "unit": spec.unit, "described": spec.describe()}
 
 
 def candidate_priors(effect: str, scale: DeviceScale, known: Mapping[str, float] | None = None
@@ -265,30 +289,53 @@ REFERENCE_WIDEN = 1.5
 
 def candidate_reference(effect: str, nested: ModelFit, detection: Detection | None,
                         priors: Mapping[str, PriorSpec]) -> Reference | None:
-    """Where the TMCMC of a candidate with a ``Probe.start_shape`` starts half its particles
-    (``harvester.inference.reference``): that shape where the detection's scan places it
-    (:func:`scan_factor`), the parameters it shares with the model it extends at that model's
-    posterior (a Gaussian, sds widened by REFERENCE_WIDEN), its other parameters from their
-    priors. ``priors`` must be the ones the candidate's model is built with.
+    """Where the TMCMC of a candidate starts half its particles (``harvester.inference.
+    reference``): the parameters it shares with the model it extends at that model's
+    posterior (a Gaussian, sds widened by REFERENCE_WIDEN), a ``Probe.start_shape`` (a
+    mode's frequency) where the detection's scan places it (:func:`scan_factor`), its other
+    parameters from their priors. ``priors`` must be the ones the candidate's model is built
+    with. The other half start from the prior, which bounds the weights.
 
-    None (start from the prior) for every other candidate: an added term that trades off
-    against the nested model's parameters (Coulomb friction against F_c, say) moves them
-    along a ridge the Gaussian does not hold: started there, a chain collapsed in 3 of 10
-    Coulomb-friction runs (8 in the forced-candidate check, 2 in the medium grid; commit
-    e1e8381), against none of 10 Stribeck-friction runs."""
+    Started there the tempering needs a few stages, not a dozen, and skips the prior's
+    stiffest corners. (With random-walk moves alone, an added term that trades off against
+    the nested model's parameters, Coulomb friction against F_c, collapsed in 3 of 10 runs,
+    commit e1e8381; a population that collapses all the same is sampled again from the prior,
+    :func:`candidate_fit`.) None when the nested posterior is too small or degenerate."""
     scan = scan_factor(effect, detection, priors)
-    if scan is None or nested.samples is None or len(nested.samples) < 2 * len(nested.names):
+    if nested.samples is None or len(nested.samples) < 2 * len(nested.names):
         return None
     lowers = tuple(float(priors[n].lower) for n in nested.names)
     inside = np.all(nested.samples >= np.asarray(lowers)[None, :], axis=1)
     try:
         gaussian = GaussianFactor.from_samples(tuple(nested.names), nested.samples[inside],
                                                lowers, REFERENCE_WIDEN)
-    except ValueError as err:  # a degenerate posterior: the scan alone
+    except ValueError as err:  # a degenerate posterior: the scan alone, or the prior
         log.warning("no Gaussian start for %s (%s)", effect, err)
-        return Reference({scan.name: priors[scan.name]}, (scan,), REFERENCE_SHARE)
-    names = (*nested.names, scan.name)
-    return Reference({n: priors[n] for n in names}, (gaussian, scan), REFERENCE_SHARE)
+        return None if scan is None else Reference({scan.name: priors[scan.name]}, (scan,),
+                                                   REFERENCE_SHARE)
+    factors = (gaussian,) if scan is None else (gaussian, scan)
+    names = (*nested.names, *(() if scan is None else (scan.name,)))
+    return Reference({n: priors[n] for n in names}, factors, REFERENCE_SHARE)
+
+
+def map_reference(point, priors: Mapping[str, PriorSpec]) -> Reference | None:
+    """Where a baseline's TMCMC starts half its particles: a Gaussian at its MAP with the
+    Laplace covariance widened by REFERENCE_WIDEN, sigma at the MAP's RMS residual with a
+    fifth of it as sd (``baseline.PointFit``); the other half from the prior. None when the
+    Laplace covariance is not usable."""
+    names = tuple(point.names)
+    p = len(point.theta) - 1
+    cov = np.zeros((p + 1, p + 1))
+    cov[:p, :p] = np.asarray(point.cov) * REFERENCE_WIDEN**2
+    cov[p, p] = (0.2 * point.theta[-1]) ** 2
+    lowers = tuple(float(priors[n].lower) for n in names)
+    try:
+        gaussian = GaussianFactor(names, tuple(map(float, point.theta)),
+                                  tuple(map(tuple, cov)), lowers)
+    except ValueError as err:
+        log.warning("no Gaussian start at the MAP (%s): tempering from the prior", err)
+        return None
+    return Reference({n: priors[n] for n in names}, (gaussian,), REFERENCE_SHARE)
 
 
 def scan_factor(effect: str, detection: Detection | None,
@@ -440,22 +487,48 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
                  len(effects))
         fit = candidate_fit(baseline, effect, priors, settings, scale, detection,
                             seed_offset + 101 * (i + 1))
-        delta = fit.log_evidence - baseline.log_evidence
-        se = float(np.hypot(fit.log_evidence_se, baseline.log_evidence_se))
-        threshold = settings.base_threshold + settings.mc_sigmas * se
-        results.append(CandidateResult(effect, fit, float(delta), se, float(threshold),
-                                       bool(delta > threshold)))
-    # indistinguishable: within a few nats of the best accepted one
-    accepted = sorted([r for r in results if r.accepted], key=lambda r: -r.delta_log_evidence)
-    if accepted:
-        best = accepted[0]
-        for r in results:
-            if r is best:
-                continue
-            gap = best.delta_log_evidence - r.delta_log_evidence
-            if gap < max(settings.indistinguishable_nats,
-                         settings.mc_sigmas * np.hypot(best.delta_se, r.delta_se)):
-                r.indistinguishable_from.append(best.effect)
-                best.indistinguishable_from.append(r.effect)
+        results.append(judge(effect, fit, baseline, settings))
     results.sort(key=lambda r: -r.delta_log_evidence)
+    mark_ties(results, settings)
     return results
+
+
+def judge(effect: str, fit: ModelFit, baseline: ModelFit, settings: ConfirmSettings
+          ) -> CandidateResult:
+    """The candidate's evidence against the baseline and its acceptance: delta log evidence
+    above log(1/alpha) + mc_sigmas standard errors, and no added parameter piled against a
+    bound of its prior (then the prior cut off what the data wanted: flagged, not trusted)."""
+    delta = fit.log_evidence - baseline.log_evidence
+    se = float(np.hypot(fit.log_evidence_se, baseline.log_evidence_se))
+    threshold = settings.base_threshold + settings.mc_sigmas * se
+    edges = {}
+    for name in term(effect).parameter_names:
+        j = fit.names.index(name)
+        side = at_prior_edge(fit.priors[name], fit.samples[:, j])
+        if side is not None:
+            edges[name] = side
+    if edges:
+        log.warning("%s: the posterior of %s piles against the prior's bound (%s): not trusted",
+                    fit.structure.name, ", ".join(edges), ", ".join(edges.values()))
+    return CandidateResult(effect, fit, float(delta), se, float(threshold),
+                           bool(delta > threshold and not edges), at_prior_edge=edges)
+
+
+def mark_ties(results: list[CandidateResult], settings: ConfirmSettings) -> None:
+    """The best accepted candidate is named alone only if every physically different
+    candidate (``harvester.model.terms.same_physics``) trails it by more than the acceptance
+    threshold (log(1/alpha) plus mc_sigmas standard errors of the gap); the others within it
+    are recorded as indistinguishable from it, both ways. ``results`` best first."""
+    accepted = [r for r in results if r.accepted]
+    if not accepted:
+        return
+    best = accepted[0]
+    for r in results:
+        if r is best or same_physics(r.effect, best.effect):
+            continue
+        gap = best.delta_log_evidence - r.delta_log_evidence
+        margin = settings.base_threshold + settings.mc_sigmas * np.hypot(best.delta_se,
+                                                                         r.delta_se)
+        if gap <= margin:
+            r.indistinguishable_from.append(best.effect)
+            best.indistinguishable_from.append(r.effect)

@@ -310,98 +310,142 @@ def _replicate_p(replicates: np.ndarray) -> np.ndarray:
     return np.where(replicates == -np.inf, 1.0, p)
 
 
-def detect(state: BaselineState, window: tuple[int, int], priors: Mapping[str, PriorSpec],
-           candidates: list[str], settings: DetectionSettings = DetectionSettings(),
-           time: np.ndarray | None = None) -> Detection:
-    """Calibrated detection and location of a mismatch of the baseline over ``window``.
+@dataclass
+class Whitened:
+    """The residual in the detection's frame: weighted by the inverse of its smoothed
+    spectrum, with what the baseline's parameters absorb projected out."""
 
-    The analysed band ends at ``settings.band_fraction`` x the measurement chain's cut-off
-    (the problem's ``lowpass_hz``; Nyquist when there is none).
-    """
-    problem = state.problem
-    fs = 1.0 / problem.dt
-    start, stop = window
-    if stop > len(state.residual):
-        raise ValueError(f"window {window} beyond the problem's record ({len(state.residual)})")
-    f_high = settings.band_fraction * (problem.lowpass_hz or 0.5 * fs)
-    frame = Frame(fs, start, stop, f_high)
-    time = np.arange(len(problem.rel_acc)) * problem.dt if time is None else time
+    frame: Frame
+    raw: np.ndarray          # DFT of the residual over the window
+    jacobian: np.ndarray     # (P, bins) DFT of the sensitivities
+    spectrum: np.ndarray     # smoothed periodogram of the residual
+    metric: Metric
+    projector: Projector
+    residual: np.ndarray     # projected residual (1, bins)
+    temper: float
 
+
+def whiten(state: BaselineState, window: tuple[int, int], f_high: float) -> Whitened:
+    """The frame, metric and projected residual of ``state`` over ``window``."""
+    frame = Frame(1.0 / state.problem.dt, window[0], window[1], f_high)
     raw = frame.dft(state.residual)
     jac = frame.dft(state.jacobian.T)
     first = Projector(Metric(frame.mask), jac).apply(raw)
     spectrum = frame.smoothed_periodogram(first)
     metric = Metric(frame.mask / spectrum)
     proj = Projector(metric, jac)
-    resid = proj.apply(raw)
-    temper = temper_from_spectrum(raw, spectrum, frame)
+    return Whitened(frame, raw, jac, spectrum, metric, proj, proj.apply(raw),
+                    temper_from_spectrum(raw, spectrum, frame))
 
-    scale = motion_scale(state, window, f_high)
-    sigs = signatures(state, scale, candidates)
-    G = frame.dft(np.array([s.values for s in sigs])) if sigs else np.zeros((0, raw.size))
-    Gp = proj.apply(G) if sigs else G
-    absorbed = proj.coefficients(G) if sigs and proj.solve else np.zeros((len(sigs), 0))
-    gram = np.einsum("ij,ij->i", Gp.real * metric.weight, Gp.real) + \
-        np.einsum("ij,ij->i", Gp.imag * metric.weight, Gp.imag)
 
-    rng = np.random.default_rng(settings.seed)
-    # two sets of replicates: noise whose level follows the residual's (for the score tests,
-    # robust to noise that grows and shrinks with the motion, e.g. base-sensor noise seen
-    # through sticking and sliding), and stationary noise (for the energy-share locations)
-    envelope = level_envelope(state.residual[start:stop], fs, settings.window_s)
+def replicates(state: BaselineState, w: Whitened, window: tuple[int, int],
+               settings: DetectionSettings, rng: np.random.Generator
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """Projected noise replicates: (level-following plus filter artefacts, for the score
+    tests; stationary, for the energy-share locations)."""
+    frame = w.frame
+    envelope = level_envelope(state.residual[window[0]:window[1]], frame.fs, settings.window_s)
     artifacts = filter_artifacts(state, frame, min(settings.artifact_components,
                                                    settings.bootstrap), rng)
-    noise_spectrum = spectrum
+    noise_spectrum = w.spectrum
     if len(artifacts):
         art_power = frame.smoothed_mean(np.mean(np.abs(artifacts) ** 2, axis=0))
-        noise_spectrum = np.maximum(spectrum - art_power, 0.5 * spectrum)
+        noise_spectrum = np.maximum(w.spectrum - art_power, 0.5 * w.spectrum)
     reps = noise_replicates(noise_spectrum, frame, settings.bootstrap, rng, envelope)
     if len(artifacts):
         reps += artifacts[np.arange(settings.bootstrap) % len(artifacts)]
-    reps = proj.apply(reps)
-    reps_stationary = proj.apply(noise_replicates(spectrum, frame, settings.bootstrap, rng))
-    log.info("detection over %.1f-%.1f s, band %.2f-%.1f Hz, %d signatures, %d replicates",
-             time[start], time[stop - 1], frame.f_low, f_high, len(sigs), settings.bootstrap)
+    stationary = noise_replicates(w.spectrum, frame, settings.bootstrap, rng)
+    return w.projector.apply(reps), w.projector.apply(stationary)
 
-    # library: score tests
-    fam_obs: dict[str, float] = {}
-    fam_rep: dict[str, np.ndarray] = {}
-    cand_scores: list[CandidateScore] = []
-    z = np.zeros(len(sigs))
-    if sigs:
-        s_obs = metric.inner(resid, Gp)[0]
-        s_rep = metric.inner(reps, Gp)
-        sd = s_rep.std(axis=0, ddof=1)
-        sd = np.where(sd > 0, sd, np.inf)
-        z = s_obs / sd
-        z_rep = s_rep / sd
-        signed = np.array([s.signed for s in sigs])
-        stat = np.where(signed, z**2, np.maximum(z, 0) ** 2)
-        stat_rep = np.where(signed, z_rep**2, np.maximum(z_rep, 0) ** 2)
-        total_w = float(metric.inner(resid, resid)[0, 0])
-        effects = list(dict.fromkeys(s.effect for s in sigs))
-        eff_obs, eff_rep = [], []
-        for e in effects:
-            idx = np.array([i for i, s in enumerate(sigs) if s.effect == e])
-            best = int(idx[np.argmax(stat[idx])])
-            eff_obs.append(stat[best])
-            eff_rep.append(np.max(stat_rep[:, idx], axis=1))
-            g2 = max(gram[best], 1e-300)
-            cand_scores.append(CandidateScore(
-                effect=e, label=sigs[best].label, index=best, z=float(z[best]),
-                statistic=float(stat[best]), p_value=_rank_p(stat[best], eff_rep[-1]),
-                strength=float(s_obs[best] / g2), strength_se=float(sd[best] / g2),
-                explained_share=float(s_obs[best] ** 2 / g2 / total_w)))
-        fam_obs["library"] = float(np.max(eff_obs))
-        fam_rep["library"] = np.max(np.array(eff_rep), axis=0)
 
-    # windows and regions: shares of band-limited residual energy
-    series = frame.band_limited(resid)
-    series_rep = frame.band_limited(reps_stationary)
+@dataclass
+class SignatureSet:
+    """The candidates' signatures in the whitened frame."""
+
+    signatures: list[Signature]
+    projected: np.ndarray    # (signatures, bins) projected DFTs
+    absorbed: np.ndarray     # (signatures, P) parameter shift per unit strength
+    gram: np.ndarray         # <g_perp, g_perp> per signature
+
+
+def signature_set(state: BaselineState, w: Whitened, window: tuple[int, int], f_high: float,
+                  candidates: list[str]) -> SignatureSet:
+    """Each candidate's signatures, projected like the residual."""
+    sigs = signatures(state, motion_scale(state, window, f_high), candidates)
+    if not sigs:
+        return SignatureSet([], np.zeros((0, w.raw.size)), np.zeros((0, 0)), np.zeros(0))
+    dft = w.frame.dft(np.array([s.values for s in sigs]))
+    projected = w.projector.apply(dft)
+    absorbed = w.projector.coefficients(dft) if w.projector.solve \
+        else np.zeros((len(sigs), 0))
+    weight = w.metric.weight
+    gram = np.einsum("ij,ij->i", projected.real * weight, projected.real) + \
+        np.einsum("ij,ij->i", projected.imag * weight, projected.imag)
+    return SignatureSet(sigs, projected, absorbed, gram)
+
+
+@dataclass
+class ScoreTests:
+    """The score test of every signature and the best per effect."""
+
+    z: np.ndarray
+    candidates: list[CandidateScore]
+    statistic: float | None          # the family's largest effect statistic
+    replicates: np.ndarray | None    # its replicates
+
+
+def score_tests(w: Whitened, sigs: SignatureSet, reps: np.ndarray) -> ScoreTests:
+    """z = <g_perp, r> / sd per signature; an effect's statistic is its largest z^2 (one-sided
+    where its strength cannot be negative) over its shape grid (module docstring)."""
+    if not sigs.signatures:
+        return ScoreTests(np.zeros(0), [], None, None)
+    s_obs = w.metric.inner(w.residual, sigs.projected)[0]
+    s_rep = w.metric.inner(reps, sigs.projected)
+    sd = s_rep.std(axis=0, ddof=1)
+    sd = np.where(sd > 0, sd, np.inf)
+    z, z_rep = s_obs / sd, s_rep / sd
+    signed = np.array([s.signed for s in sigs.signatures])
+    stat = np.where(signed, z**2, np.maximum(z, 0) ** 2)
+    stat_rep = np.where(signed, z_rep**2, np.maximum(z_rep, 0) ** 2)
+    total = float(w.metric.inner(w.residual, w.residual)[0, 0])
+    scores, best_reps = [], []
+    for effect in dict.fromkeys(s.effect for s in sigs.signatures):
+        idx = np.array([i for i, s in enumerate(sigs.signatures) if s.effect == effect])
+        best = int(idx[np.argmax(stat[idx])])
+        best_reps.append(np.max(stat_rep[:, idx], axis=1))
+        g2 = max(sigs.gram[best], 1e-300)
+        scores.append(CandidateScore(
+            effect=effect, label=sigs.signatures[best].label, index=best, z=float(z[best]),
+            statistic=float(stat[best]), p_value=_rank_p(stat[best], best_reps[-1]),
+            strength=float(s_obs[best] / g2), strength_se=float(sd[best] / g2),
+            explained_share=float(s_obs[best] ** 2 / g2 / total)))
+    return ScoreTests(z, scores, float(max(c.statistic for c in scores)),
+                      np.max(np.array(best_reps), axis=0))
+
+
+@dataclass
+class Where:
+    """Shares of band-limited residual energy in time windows and state regions, and the
+    measured-to-model amplitude per region."""
+
+    windows: TimeWindows
+    window_stats: Standardised
+    regions: StateRegions
+    region_stats: Standardised
+    region_gain: Standardised
+    series: np.ndarray               # band-limited residual over the window
+    family: dict[str, tuple[float, np.ndarray]]  # gated statistics: observed, replicates
+
+
+def where(state: BaselineState, w: Whitened, stationary: np.ndarray, time: np.ndarray,
+          settings: DetectionSettings) -> Where:
+    """Time windows and state regions against stationary replicates (``locate.py``)."""
+    frame = w.frame
+    series, series_rep = frame.band_limited(w.residual), frame.band_limited(stationary)
     windows = TimeWindows(frame, time, settings.window_s)
     w_stats = standardise(windows.statistic(series), windows.statistic(series_rep))
     regions = StateRegions(frame, state.rel_disp, state.rel_vel, state.rel_acc,
-                           problem.base_acc)
+                           state.problem.base_acc)
     standstill = MeasuredStandstill(frame, state.rel_acc)
     # the regions' statistics are log(energy share); the standstill's is log(share / time
     # share) (its mask moves with the data), put on the same footing for the gate below
@@ -409,14 +453,25 @@ def detect(state: BaselineState, window: tuple[int, int], priors: Mapping[str, P
     rep = np.column_stack([regions.statistic(series_rep), standstill.statistic(series_rep)])
     r_stats = standardise(obs, rep)
     regions.add(standstill, float(np.mean(standstill.mask(series))))
-    # amplitude ratio measured / model in each region: 1 + <r, m> / <m, m> (0: the data do
-    # not move where the model does, as when the real device sticks)
+    gain = region_gains(frame, state, regions, standstill, series, series_rep)
+    # a window or region enters the verdict only if it also holds a gross excess of energy
+    w_gate = np.log(settings.gross_window_ratio * windows.expected_share())
+    r_gate = np.log(settings.gross_region_ratio * regions.time_share())
+    r_gate[-1] = np.log(settings.gross_region_ratio)  # the standstill's statistic is a ratio
+    family = {"windows": gated_max(w_stats, w_gate), "regions": gated_max(r_stats, r_gate)}
+    return Where(windows, w_stats, regions, r_stats, gain, series, family)
+
+
+def region_gains(frame: Frame, state: BaselineState, regions: StateRegions,
+                 standstill: MeasuredStandstill, series: np.ndarray, series_rep: np.ndarray
+                 ) -> Standardised:
+    """Amplitude ratio measured / model in each region, 1 + <r, m> / <m, m> (0: the data do
+    not move where the model does, as when the real device sticks)."""
     model_band = frame.band_limited(frame.dft(state.rel_acc))
 
     def gains(res: np.ndarray) -> np.ndarray:
-        masks = np.vstack([regions.matrix, standstill.mask(res)[None, :]]) if res.ndim == 1 \
-            else None
-        if masks is not None:
+        if res.ndim == 1:
+            masks = np.vstack([regions.matrix, standstill.mask(res)[None, :]])
             return 1.0 + (masks @ (res * model_band)) / np.maximum(masks @ model_band**2, 1e-300)
         fixed = 1.0 + (res * model_band) @ regions.matrix.T / np.maximum(
             regions.matrix @ model_band**2, 1e-300)
@@ -426,51 +481,85 @@ def detect(state: BaselineState, window: tuple[int, int], priors: Mapping[str, P
         return np.column_stack([fixed, still])
 
     g_obs, g_rep = gains(series), gains(series_rep)
-    gain_stats = standardise(-np.abs(np.log(np.maximum(g_obs, 1e-3))),
-                             -np.abs(np.log(np.maximum(g_rep, 1e-3))))
-    gain_stats = Standardised(g_obs, -gain_stats.z, -gain_stats.z_replicates, g_rep)
-    # a window or region enters the verdict only if it also holds a gross excess of energy
-    w_gate = np.log(settings.gross_window_ratio * windows.expected_share())
-    r_gate = np.log(settings.gross_region_ratio * regions.time_share())
-    r_gate[-1] = np.log(settings.gross_region_ratio)  # the standstill's statistic is a ratio
-    fam_obs["windows"], fam_rep["windows"] = gated_max(w_stats, w_gate)
-    fam_obs["regions"], fam_rep["regions"] = gated_max(r_stats, r_gate)
+    stats = standardise(-np.abs(np.log(np.maximum(g_obs, 1e-3))),
+                        -np.abs(np.log(np.maximum(g_rep, 1e-3))))
+    return Standardised(g_obs, -stats.z, -stats.z_replicates, g_rep)
 
-    family_p = {f: _rank_p(fam_obs[f], fam_rep[f]) for f in fam_obs}
-    p_value = family_p.get("library", 1.0)
 
-    # frequency bands: residual energy and the part the signatures explain
-    bands = FrequencyBands(frame)
-    band_energy = bands.band_energy(resid)
-    if sigs:
-        gg = metric.gram(Gp)
-        scl = np.sqrt(np.maximum(np.diag(gg), 1e-300))
-        pinv = np.linalg.pinv(gg / np.outer(scl, scl), rcond=1e-6) / np.outer(scl, scl)
-        explained = (pinv @ metric.inner(Gp, resid))[:, 0] @ Gp
-        explained_rep = (metric.inner(reps_stationary, Gp) @ pinv.T) @ Gp
+@dataclass
+class BandShares:
+    """Residual energy per frequency band and the share the signatures explain."""
+
+    bands: FrequencyBands
+    energy: np.ndarray
+    explained: np.ndarray
+    stats: Standardised
+    explained_series: np.ndarray     # the explained part, band-limited
+
+
+def band_shares(w: Whitened, sigs: SignatureSet, stationary: np.ndarray) -> BandShares:
+    """Per band: the residual's energy and the part the signatures explain together
+    (least squares in the metric), against the stationary replicates."""
+    bands = FrequencyBands(w.frame)
+    energy = bands.band_energy(w.residual)
+    if sigs.signatures:
+        gram = w.metric.gram(sigs.projected)
+        norm = np.sqrt(np.maximum(np.diag(gram), 1e-300))
+        pinv = np.linalg.pinv(gram / np.outer(norm, norm), rcond=1e-6) / np.outer(norm, norm)
+        explained = (pinv @ w.metric.inner(sigs.projected, w.residual))[:, 0] @ sigs.projected
+        explained_rep = (w.metric.inner(stationary, sigs.projected) @ pinv.T) @ sigs.projected
     else:
-        explained = np.zeros_like(resid)
-        explained_rep = np.zeros_like(reps_stationary)
-    tot = band_energy.sum()
+        explained = np.zeros_like(w.residual)
+        explained_rep = np.zeros_like(stationary)
     band_expl = bands.band_energy(explained)
-    band_expl_rep = bands.band_energy(explained_rep) / bands.band_energy(reps_stationary).sum(
+    band_expl_rep = bands.band_energy(explained_rep) / bands.band_energy(stationary).sum(
         axis=1, keepdims=True)
-    b_stats = standardise(band_expl / tot, band_expl_rep)
+    stats = standardise(band_expl / energy.sum(), band_expl_rep)
+    return BandShares(bands, energy, band_expl, stats, w.frame.band_limited(explained))
 
-    names = problem.parameter_names
-    conflicts = prior_conflicts(names, state.samples, priors, settings)
-    sigma = float(np.sqrt(np.mean(state.residual[start:stop] ** 2)))
+
+def detect(state: BaselineState, window: tuple[int, int], priors: Mapping[str, PriorSpec],
+           candidates: list[str], settings: DetectionSettings = DetectionSettings(),
+           time: np.ndarray | None = None) -> Detection:
+    """Calibrated detection and location of a mismatch of the baseline over ``window``.
+
+    The analysed band ends at ``settings.band_fraction`` x the measurement chain's cut-off
+    (the problem's ``lowpass_hz``; Nyquist when there is none).
+    """
+    problem = state.problem
+    if window[1] > len(state.residual):
+        raise ValueError(f"window {window} beyond the problem's record ({len(state.residual)})")
+    f_high = settings.band_fraction * (problem.lowpass_hz or 0.5 / problem.dt)
+    time = np.arange(len(problem.rel_acc)) * problem.dt if time is None else time
+    w = whiten(state, window, f_high)
+    sigs = signature_set(state, w, window, f_high, candidates)
+    reps, stationary = replicates(state, w, window, settings,
+                                  np.random.default_rng(settings.seed))
+    log.info("detection over %.1f-%.1f s, band %.2f-%.1f Hz, %d signatures, %d replicates",
+             time[window[0]], time[window[1] - 1], w.frame.f_low, f_high,
+             len(sigs.signatures), settings.bootstrap)
+    scores = score_tests(w, sigs, reps)
+    located = where(state, w, stationary, time, settings)
+    family = dict(located.family)
+    if scores.statistic is not None:
+        family = {"library": (scores.statistic, scores.replicates), **family}
+    family_p = {f: _rank_p(obs, rep) for f, (obs, rep) in family.items()}
+    shares = band_shares(w, sigs, stationary)
+    conflicts = prior_conflicts(problem.parameter_names, state.samples, priors, settings)
     det = Detection(
-        frame=frame, temper=temper, alpha=settings.alpha, p_value=p_value, family_p=family_p,
-        family_statistic=fam_obs, signatures=sigs, z=z, absorbed=absorbed, gram=gram,
-        signature_dft=Gp, metric=metric,
-        candidates=cand_scores, conflicts=conflicts, windows=windows, window_stats=w_stats,
-        regions=regions, region_stats=r_stats, region_gain=gain_stats, bands=bands,
-        band_energy=band_energy,
-        band_explained=band_expl, band_explained_stats=b_stats, spectrum=spectrum,
-        residual_dft=resid, residual_band=series, explained_band=frame.band_limited(explained),
-        sigma=sigma)
-    log.info("detection: p = %.3g (%s); conflicts: %s", p_value,
+        frame=w.frame, temper=w.temper, alpha=settings.alpha,
+        p_value=family_p.get("library", 1.0), family_p=family_p,
+        family_statistic={f: obs for f, (obs, _) in family.items()},
+        signatures=sigs.signatures, z=scores.z, absorbed=sigs.absorbed, gram=sigs.gram,
+        signature_dft=sigs.projected, metric=w.metric, candidates=scores.candidates,
+        conflicts=conflicts, windows=located.windows, window_stats=located.window_stats,
+        regions=located.regions, region_stats=located.region_stats,
+        region_gain=located.region_gain, bands=shares.bands, band_energy=shares.energy,
+        band_explained=shares.explained, band_explained_stats=shares.stats,
+        spectrum=w.spectrum, residual_dft=w.residual, residual_band=located.series,
+        explained_band=shares.explained_series,
+        sigma=float(np.sqrt(np.mean(state.residual[window[0]:window[1]] ** 2))))
+    log.info("detection: p = %.3g (%s); conflicts: %s", det.p_value,
              ", ".join(f"{f} p={p:.3g}" for f, p in family_p.items()),
              ", ".join(c.parameter for c in conflicts if c.conflict) or "none")
     return det

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
 from harvester.diagnosis.baseline import ChainProblem
+from harvester.diagnosis.confirm import prior_dict
 from harvester.inference.predictive import nrmse, outside_fraction, thin
 
 
@@ -158,9 +159,9 @@ def diagnosis_dict(d) -> dict:
     return _finite(_diagnosis_dict(d))
 
 
-def _diagnosis_dict(d) -> dict:
-    first = d.rounds[0]
-    candidates = []
+def _candidate_entries(d) -> list[dict]:
+    """Every candidate sampled in every round, with its gain over the first baseline."""
+    out = []
     for i, rnd in enumerate(d.rounds):
         for res in rnd.confirmed:
             entry = res.to_dict()
@@ -168,7 +169,12 @@ def _diagnosis_dict(d) -> dict:
             entry["reference"] = rnd.structure
             entry["delta_log_evidence_vs_baseline"] = (res.fit.log_evidence
                                                         - d.baseline_log_evidence)
-            candidates.append(entry)
+            out.append(entry)
+    return out
+
+
+def _fit_section(d) -> dict:
+    """The fit before and after: parameters, evidence, unseen-data errors."""
     improved_ev = d.improved_fit.log_evidence if d.improved_fit else d.baseline_log_evidence
     fit = {"baseline": _fit_entry(d.baseline, d.baseline_log_evidence,
                                   d.baseline_evidence_source, d.unseen_before),
@@ -184,25 +190,37 @@ def _diagnosis_dict(d) -> dict:
                  for p in term(t).parameter_names]
         summ = d.improved_fit.summary()
         fit["added_parameters"] = {n: summ[n] for n in added if n in summ}
+    return fit
+
+
+def _rounds(d) -> list[dict]:
+    return [{"structure": rnd.structure, "p_value": rnd.detection.p_value,
+             "significant": rnd.detection.significant,
+             "prior_conflict": rnd.detection.conflict,
+             "sampled": [r.effect for r in rnd.confirmed],
+             "accepted": rnd.accepted.effect if rnd.accepted else None,
+             "named": bool(rnd.accepted and rnd.accepted.named),
+             "device_scale": asdict(rnd.scale) if rnd.scale is not None else None}
+            for rnd in d.rounds]
+
+
+def _diagnosis_dict(d) -> dict:
+    first = d.rounds[0]
     s = d.settings
     return {
         "verdict": d.verdict,
         "missing": d.missing,
         "indistinguishable": d.indistinguishable,
+        "ties": [tie.to_dict() for tie in d.ties],
         "unexplained_mismatch": d.unexplained,
         "baseline": d.baseline.name,
         "improved": d.improved.name,
-        "candidates": candidates,
+        "candidates": _candidate_entries(d),
         "locations": _locations(first.detection),
-        "fit": fit,
+        "fit": _fit_section(d),
         "detection": _detection(first.detection),
         "ranking": [r.to_dict() for r in first.ranked],
-        "rounds": [{"structure": rnd.structure, "p_value": rnd.detection.p_value,
-                    "significant": rnd.detection.significant,
-                    "prior_conflict": rnd.detection.conflict,
-                    "sampled": [r.effect for r in rnd.confirmed],
-                    "accepted": rnd.accepted.effect if rnd.accepted else None}
-                   for rnd in d.rounds],
+        "rounds": _rounds(d),
         "measurement_chain": {"lowpass_hz": d.lowpass_hz, "filter_order": s.filter_order,
                               "likelihood_lowpass_hz": d.likelihood_lowpass_hz,
                               "tempering_lambda": d.temper,
@@ -210,9 +228,7 @@ def _diagnosis_dict(d) -> dict:
         "analysis_window_s": list(d.window_s),
         "tmcmc_window_s": list(d.fit_window_s),
         "traded_away": d.settings.trades(),
-        "priors": {k: {"family": v.family, "mean": v.mean, "sd": v.sd, "lower": v.lower,
-                       "upper": v.upper, "unit": v.unit, "described": v.describe()}
-                   for k, v in d.priors.items()},
+        "priors": {k: prior_dict(v) for k, v in d.priors.items()},
         "settings": {k: (list(v) if isinstance(v, tuple) else v)
                      for k, v in s.__dict__.items()},
         "runtime_s": d.seconds,

@@ -12,17 +12,14 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from harvester.data.fileio import atomic_path  # noqa: E402
 from harvester.emps.data import UNITS, EmpsRecord, disturbance_voltage  # noqa: E402
+from harvester.plots.style import BOUNDS, MEASURED, MODEL, save_figure  # noqa: E402
 
 REAL_NOTE = "real recordings: EMPS benchmark (Janot, Gautier and Brunot 2019)"
 
 
 def _save(fig, path: str | Path) -> None:
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=120, format="png")
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def data_figure(records: Mapping[str, EmpsRecord], path: str | Path) -> None:
@@ -59,15 +56,16 @@ def frf_figure(freqs: np.ndarray, measured: np.ndarray, model: np.ndarray, coher
     f = freqs[sel]
     fig, ax = plt.subplots(3, 1, figsize=(7, 7.5), sharex=True,
                            gridspec_kw={"height_ratios": [3, 2, 1.2]})
-    ax[0].loglog(f, np.abs(measured[sel]), color="0.6", lw=1.2, label="measured (instrument $q_g$)")
-    ax[0].loglog(f, np.abs(model[sel]), color="k", lw=1.0, label="fitted linear eq. (1)")
+    ax[0].loglog(f, np.abs(measured[sel]), color=MEASURED, lw=1.2,
+                 label="measured (instrument $q_g$)")
+    ax[0].loglog(f, np.abs(model[sel]), color=MODEL, lw=1.0, label="fitted linear eq. (1)")
     ax[0].set_ylabel("|position / force| (m/N)")
     ax[0].legend(fontsize=8, frameon=False)
     def phase(h: np.ndarray) -> np.ndarray:  # in [-360, 0): a mass line sits at -180
         return np.degrees(np.angle(h)) % 360.0 - 360.0
 
-    ax[1].semilogx(f, phase(measured[sel]), color="0.6", lw=1.2)
-    ax[1].semilogx(f, phase(model[sel]), color="k", lw=1.0)
+    ax[1].semilogx(f, phase(measured[sel]), color=MEASURED, lw=1.2)
+    ax[1].semilogx(f, phase(model[sel]), color=MODEL, lw=1.0)
     ax[1].set_ylabel("phase (deg)")
     ax[1].set_ylim(-360, 0)
     ax[2].semilogx(f, coherence[sel], color="0.4", lw=1.0)
@@ -115,9 +113,9 @@ def tracking_figure(bands: Mapping[str, dict], path: str | Path, title: str,
     last = list(bands)[-1]
     t = bands[last]["time"]
     sel = slice(None) if window is None else (t >= window[0]) & (t <= window[1])
-    axes[0].plot(t[sel], 1e6 * bands[last]["measured"][sel], color="0.6", lw=2.0,
+    axes[0].plot(t[sel], 1e6 * bands[last]["measured"][sel], color=MEASURED, lw=2.0,
                  label="measured $q_m - q_g$")
-    axes[0].plot(t[sel], 1e6 * bands[last]["mean"][sel], color="k", lw=0.7,
+    axes[0].plot(t[sel], 1e6 * bands[last]["mean"][sel], color=MODEL, lw=0.7,
                  label=f"{last}, mean (closed loop)")
     axes[0].set_ylabel("tracking error ($\\mu$m)")
     axes[0].legend(fontsize=8, frameon=False, loc="upper left")
@@ -125,7 +123,8 @@ def tracking_figure(bands: Mapping[str, dict], path: str | Path, title: str,
     for ax, (label, b) in zip(axes[1:], bands.items()):
         err = 1e6 * (b["measured"] - b["mean"])[sel]
         sd = 1e6 * b["sd"][sel]
-        ax.fill_between(t[sel], -k * sd, k * sd, color="tab:blue", alpha=0.2, lw=0,
+        ax.fill_between(t[sel], -k * sd, k * sd, color=BOUNDS["predictive"][0],
+                        alpha=BOUNDS["predictive"][1], lw=0,
                         label=f"$\\pm${k:g} sd (parameters + $\\sigma$)")
         ax.plot(t[sel], err, color="0.4", lw=0.6, label="measured - model mean")
         ax.axhline(0.0, color="k", lw=0.5)

@@ -4,13 +4,15 @@ For every scenario of ``harvester.synthetic.scenarios`` (effect x contribution-t
 diagnosis runs on the recording through :func:`run_diagnosis`; this module turns the results
 into the detection table, the confusion matrix and the false-alarm rate.
 
-Scoring one scenario whose true effect is e (``named``): the diagnosis names e correctly when
-e (or a name :data:`ACCEPTED` declares equivalent) is FIRST in its ``missing`` list.
-Also reported: ``tied`` (e first, or in the group of effects the diagnosis reported as
-indistinguishable by evidence from the first: it said it could not tell them apart),
-``top2`` (e among the first two) and ``flagged`` (verdict "missing_physics",
-whatever is named). On an effect-free scenario, a false alarm is the verdict
-"missing_physics".
+Scoring one scenario whose true effect is e. The correct names are the truth's own
+``correct_names`` where the generator states them (the literature generator), else e and the
+names :data:`ACCEPTED` declares equivalent. Each scenario has one ``outcome``:
+``named`` (the first effect named alone is correct), ``tied`` (nothing named alone, and a tie
+the diagnosis reported, effects it could not tell apart, holds a correct name), ``wrong`` (the
+first effect named alone is not correct, or every tie lacks a correct name: the diagnosis said
+something false), ``missed`` (adequate, or a mismatch without a name or tie). Also reported:
+``top2`` (a correct name among the first two) and ``flagged`` (verdict "missing_physics").
+On an effect-free scenario, a false alarm is the verdict "missing_physics".
 
 Rates carry Wilson score intervals (95 %). The goals of the issue: named correctly in at least
 90 % of seeds at a contribution of half the noise RMS, and at most 5 % false alarms.
@@ -53,6 +55,7 @@ UNNAMED = "unnamed"
 GOAL_RATIO = 0.5
 GOAL_NAMED_RATE = 0.9
 GOAL_FALSE_ALARM_RATE = 0.05
+GOAL_WRONG_RATE = 0.05
 
 
 # --------------------------------------------------------------------------- the diagnosis
@@ -114,10 +117,28 @@ def wilson_interval(k: int | np.ndarray, n: int | np.ndarray, level: float = 0.9
     return centre - half, centre + half
 
 
-def accepted_names(effect: str, accepted: Mapping[str, Iterable[str]] | None = None
-                   ) -> set[str]:
+def accepted_names(effect: str, accepted: Mapping[str, Iterable[str]] | None = None,
+                   truth: Mapping[str, Any] | None = None) -> set[str]:
+    """The names that count as naming ``effect``: the truth's ``correct_names`` if it states
+    them, else the effect and its :data:`ACCEPTED` equivalents."""
+    if truth is not None and truth.get("correct_names"):
+        return set(truth["correct_names"])
     acc = ACCEPTED if accepted is None else accepted
     return {effect, *acc.get(effect, ())}
+
+
+def outcome(diagnosis: Mapping[str, Any], correct: set[str]) -> str:
+    """named | tied | wrong | missed of one diagnosis of a scenario with an effect (module
+    docstring)."""
+    if diagnosis["verdict"] != "missing_physics":
+        return "missed"
+    missing = list(diagnosis.get("missing") or [])
+    if missing:
+        return "named" if missing[0] in correct else "wrong"
+    ties = [set(t.get("effects") or []) for t in diagnosis.get("ties") or []]
+    if not ties:
+        return "missed"
+    return "tied" if any(t & correct for t in ties) else "wrong"
 
 
 def information_nats(truth: Mapping[str, Any], diagnosis: Mapping[str, Any]) -> float:
@@ -146,9 +167,11 @@ def score(truth: Mapping[str, Any], diagnosis: Mapping[str, Any],
     effect = truth["effect"]
     missing = list(diagnosis.get("missing") or [])
     flagged = diagnosis["verdict"] == "missing_physics"
-    named = (missing[0] if missing else UNNAMED) if flagged else ADEQUATE
-    ok = accepted_names(effect, accepted)
+    named = (missing[0] if missing else _tie_label(diagnosis)) if flagged else ADEQUATE
+    ok = accepted_names(effect, accepted, truth)
     effect_free = float(truth["ratio"]) == 0.0
+    result = "false_alarm" if effect_free and flagged else "quiet" if effect_free \
+        else outcome(diagnosis, ok)
     screen = diagnosis.get("detection") or {}
     p_value = float(screen.get("p_value", np.nan))
     info = information_nats(truth, diagnosis)
@@ -163,8 +186,9 @@ def score(truth: Mapping[str, Any], diagnosis: Mapping[str, Any],
         # NaN information (not known) counts as nameable: the plain rate then applies
         "nameable": (not effect_free) and not info < acceptance_nats(diagnosis),
         "verdict": diagnosis["verdict"], "flagged": flagged, "named_effect": named,
-        "named": (not effect_free) and flagged and bool(missing) and missing[0] in ok,
-        "tied": (not effect_free) and flagged and bool(ok & _first_group(diagnosis, missing)),
+        "outcome": result, "named": result == "named",
+        "tied": result in ("named", "tied"), "wrong": result == "wrong",
+        "missed": result == "missed",
         "top2": (not effect_free) and flagged and bool(ok & set(missing[:2])),
         "p_value": p_value,
         # the detection screen alone (before any evidence), at its own alpha
@@ -173,12 +197,10 @@ def score(truth: Mapping[str, Any], diagnosis: Mapping[str, Any],
     }
 
 
-def _first_group(diagnosis: Mapping[str, Any], missing: list[str]) -> set[str]:
-    """The first named effect and those reported indistinguishable from it."""
-    if not missing:
-        return set()
-    groups = [set(g) for g in diagnosis.get("indistinguishable") or [] if missing[0] in g]
-    return set().union({missing[0]}, *groups)
+def _tie_label(diagnosis: Mapping[str, Any]) -> str:
+    """The first tie as "a | b", or "unnamed" when the diagnosis named nothing."""
+    ties = diagnosis.get("ties") or []
+    return " | ".join(ties[0].get("effects") or []) if ties else UNNAMED
 
 
 def results_table(pairs: Iterable[tuple[Mapping[str, Any], Mapping[str, Any]]],
@@ -208,7 +230,8 @@ def detection_table(results: pd.DataFrame, goal_ratio: float = GOAL_RATIO,
         rows.append({
             "effect": effect, "ratio": ratio, "baseline": g["baseline"].iloc[0], "seeds": n,
             "named": k, "named_rate": k / n, "named_lo": float(lo), "named_hi": float(hi),
-            "tied_rate": float(g["tied"].mean()),
+            "tied_rate": float(g["tied"].mean()), "wrong_rate": float(g["wrong"].mean()),
+            "missed_rate": float(g["missed"].mean()),
             "top2_rate": float(g["top2"].mean()), "flagged_rate": float(g["flagged"].mean()),
             "contribution_ratio_mean": float(g["contribution_ratio"].mean()),
             "unabsorbed_to_noise_mean": float(g["unabsorbed_to_noise"].mean()),
@@ -235,6 +258,8 @@ def goal_summary(results: pd.DataFrame, goal_rate: float = GOAL_NAMED_RATE) -> p
         na, ka = len(able), int(able["named"].sum())
         lo, hi = wilson_interval(k, n)
         alo, ahi = wilson_interval(ka, na) if na else (np.nan, np.nan)
+        wa = int(able["wrong"].sum())
+        wlo, whi = wilson_interval(wa, na) if na else (np.nan, np.nan)
         rows.append({
             "ratio": ratio, "scenarios": n, "named": k, "named_rate": k / n,
             "named_lo": float(lo), "named_hi": float(hi), "tied": int(g["tied"].sum()),
@@ -242,9 +267,14 @@ def goal_summary(results: pd.DataFrame, goal_rate: float = GOAL_NAMED_RATE) -> p
             "named_rate_nameable": ka / na if na else np.nan,
             "named_nameable_lo": float(alo), "named_nameable_hi": float(ahi),
             "tied_nameable": int(able["tied"].sum()),
+            "wrong": int(g["wrong"].sum()), "wrong_rate": float(g["wrong"].mean()),
+            "wrong_nameable": wa, "wrong_rate_nameable": wa / na if na else np.nan,
+            "wrong_nameable_hi": float(whi),
+            "missed_nameable": int(able["missed"].sum()),
             "not_nameable": ", ".join(sorted(set(g.loc[~g["nameable"], "effect"]))),
             "meets_goal": bool(k / n >= goal_rate),
             "meets_goal_nameable": bool(na and ka / na >= goal_rate),
+            "meets_wrong_goal_nameable": bool(na and wa / na <= GOAL_WRONG_RATE),
         })
     return pd.DataFrame(rows)
 
@@ -312,7 +342,7 @@ def detection_figure(table: pd.DataFrame, alarms: pd.DataFrame, path: str | Path
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from harvester.data.fileio import atomic_path
+    from harvester.plots.style import save_figure
 
     panels = 2 if results is not None else 1
     fig, axes = plt.subplots(1, panels, figsize=(10 + 5 * (panels - 1), 5), squeeze=False)
@@ -348,22 +378,18 @@ def detection_figure(table: pd.DataFrame, alarms: pd.DataFrame, path: str | Path
     ax.grid(alpha=0.3)
     if results is not None:
         _information_panel(axes[0, 1], results, colours, threshold_nats)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=120, format=Path(path).suffix.lstrip(".") or "png")
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 #: Outcomes of a scenario on the information panel, bottom to top.
-OUTCOMES = ("adequate", "other named", "tied", "named first")
+OUTCOMES = ("missed", "named wrong", "tied (truth among them)", "named first")
 
 
 def _information_panel(ax, results: pd.DataFrame, colours: Mapping[str, Any],
                        threshold_nats: float) -> None:
     """Each effect scenario's outcome against lambda n u^2 / 2 (nats), log scale."""
     res = results[~results["effect_free"] & np.isfinite(results["information_nats"])]
-    level = np.where(res["named"], 3, np.where(res["tied"], 2,
-                                               np.where(res["flagged"], 1, 0)))
+    level = np.select([res["named"], res["tied"], res["wrong"]], [3, 2, 1], 0)
     rng = np.random.default_rng(0)  # vertical jitter only, so coincident points show
     for effect, g in res.groupby("effect"):
         idx = res.index.get_indexer(g.index)

@@ -469,28 +469,25 @@ class TMCMC(SMC_KERNEL):
         ``compile_kwargs``; ``threshold`` is not used by TMCMC).
     """
 
+    # Per-stage statistics, all scalars (PyMC's declaration, in this order):
+    #   log_marginal_likelihood  NaN in every stage but the last, which holds the log evidence
+    #   beta, accept_rate        tempering exponent; acceptance of the Metropolis moves
+    #   log_mean_weight          log S_j = log mean(w): this stage's factor of the evidence
+    #   weights_cov              achieved coefficient of variation of the weights
+    #   log_weight_variance      variance of log S_j (families of the last resampling as
+    #                            clusters)
+    #   mcmc_steps, correlation  Metropolis moves made (int) and the correlation with the
+    #                            start they left
+    #   imh_accept_rate          acceptance of the independent (mixture) proposals
+    #   ess                      effective sample size of the weights
+    #   n_evals, wall_time       particle likelihood evaluations (int) and wall time (s) in
+    #                            the stage; the first also counts the initial (prior) population
+    #   proposal_scale           the Metropolis proposal's scale
     stats_dtypes_shapes: dict[str, tuple[type, list]] = {
-        # PyMC's convention: NaN in every stage but the last, which holds the log evidence.
-        "log_marginal_likelihood": (float, []),
-        "beta": (float, []),
-        "accept_rate": (float, []),
-        # log S_j = log mean(w): this stage's factor of the evidence.
-        "log_mean_weight": (float, []),
-        # Achieved coefficient of variation and effective sample size of the weights.
-        "weights_cov": (float, []),
-        # Variance of this stage's log S_j (families of the last resampling as clusters).
-        "log_weight_variance": (float, []),
-        # Metropolis moves made and the correlation with the start they left.
-        "mcmc_steps": (int, []),
-        "correlation": (float, []),
-        # Acceptance of the independent (mixture) proposals.
-        "imh_accept_rate": (float, []),
-        "ess": (float, []),
-        # Particle likelihood evaluations and wall time (s) in the stage; the first stage also
-        # counts evaluating the initial (prior) population.
-        "n_evals": (int, []),
-        "wall_time": (float, []),
-        "proposal_scale": (float, []),
+        name: (int if name in ("mcmc_steps", "n_evals") else float, [])
+        for name in ("log_marginal_likelihood", "beta", "accept_rate", "log_mean_weight",
+                     "weights_cov", "log_weight_variance", "mcmc_steps", "correlation",
+                     "imh_accept_rate", "ess", "n_evals", "wall_time", "proposal_scale")
     }
 
     def __init__(

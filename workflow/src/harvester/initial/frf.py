@@ -141,6 +141,70 @@ def _linear_start(f: NDArray, d: NDArray, weight: NDArray) -> NDArray:
     return np.array([max(k, 0.0), max(M, 1e-12), max(c, 1e-12)])
 
 
+def _fit_band(f: NDArray, h: NDArray, coh: NDArray, band_hz: tuple[float, float],
+              source: str) -> tuple[NDArray, NDArray, NDArray]:
+    """(frequencies Hz, FRF, weight gamma^2 / (1 - gamma^2)) of the lines fitted: inside
+    ``band_hz``, above 0 Hz, with coherence of at least :data:`MIN_COHERENCE`."""
+    band = (f >= band_hz[0]) & (f <= band_hz[1]) & (f > 0) & (coh >= MIN_COHERENCE)
+    if band.sum() < 3:
+        raise ValueError(f"{source}: fewer than 3 FRF lines with coherence >= {MIN_COHERENCE} "
+                         f"in {band_hz} Hz")
+    gamma2 = np.minimum(coh[band], MAX_COHERENCE)
+    return f[band], h[band], gamma2 / (1.0 - gamma2)
+
+
+def _refine_log_frf(fb: NDArray, hb: NDArray, weight: NDArray, kinds: RecordingKinds,
+                    hold_k: float | None, hold_c: float | None
+                    ) -> tuple[float, float, float, float]:
+    """(k, M, c, weighted RMS log-FRF residual): step (3) of the module docstring, started
+    from the linear least squares of step (2). ``hold_k``/``hold_c``: values held (None:
+    fitted). For a base input k, M, c are ratios to m."""
+    g = dynamic_stiffness_factor(fb, kinds)
+    start = _linear_start(fb, g / hb, weight)  # D (force) or D / m (base)
+    wb = 2.0 * np.pi * fb
+    scale = np.array([max(start[1] * wb.min() ** 2, 1e-12), start[1], start[2]])
+
+    def unpack(x: NDArray) -> tuple[float, float, float]:
+        k = x[0] * scale[0] if hold_k is None else float(hold_k)
+        c = np.exp(x[2]) * scale[2] if hold_c is None else float(hold_c)
+        return k, np.exp(x[1]) * scale[1], c
+
+    def residuals(x: NDArray) -> NDArray:
+        k, M, c = unpack(x)
+        res = np.log(hb * (k - M * wb**2 + 1j * c * wb) / g)
+        return np.concatenate([res.real, res.imag]) * np.sqrt(np.tile(weight, 2))
+
+    x0 = np.array([start[0] / scale[0], 0.0, 0.0])
+    sol = optimize.least_squares(residuals, x0, bounds=([0.0, -np.inf, -np.inf], np.inf))
+    k, M, c = unpack(sol.x)
+    return k, M, c, float(np.sqrt(np.sum(sol.fun**2) / (2.0 * np.sum(weight))))
+
+
+def _scale_base_ratios(ratios: dict[str, float], known: Mapping[str, float],
+                       kinds: RecordingKinds, source: str, check_units: bool
+                       ) -> tuple[dict[str, float], tuple[str, ...]]:
+    """(values, fitted) of a base input's fit, whose M, k, c_m are ratios to m: scaled by the
+    first known of M, m, k, c_m; with ``check_units``, an m/M above 1.2 is an error and one
+    off the known m/M by a factor g is reported."""
+    anchor = next((p for p in ("M", "m", "k", "c_m") if p in known and ratios[p] > 0), None)
+    if anchor is None:
+        raise ValueError(f"{source}: with a base_acc input the FRF gives only ratios to m: "
+                         "give M, m, k or c_m as known")
+    s = float(known[anchor]) / ratios[anchor]
+    values = {p: v * s for p, v in ratios.items()}
+    fitted = tuple(p for p in ("M", "m", "k", "c_m") if p != anchor)
+    if check_units:
+        m_over_M = 1.0 / ratios["M"]
+        if m_over_M > 1.2:
+            raise DataError(source, f"the FRF gives m/M = {m_over_M:.3g} > 1, impossible "
+                            "(M = m + J (2 pi / l)^2): are base_acc and rel_acc in the same "
+                            "unit (m/s^2)? A column in g is 9.81 times too small")
+        if "M" in known and "m" in known:
+            check_scale({"m_over_M": m_over_M}, {"m_over_M": known["m"] / known["M"]}, kinds,
+                        source)
+    return values, fitted
+
+
 def fit_linear_frf(recording: pd.DataFrame, known: Mapping[str, float],
                    band_hz: tuple[float, float], segment_s: float = SEGMENT_S,
                    reference: str | ArrayLike | None = None,
@@ -155,65 +219,23 @@ def fit_linear_frf(recording: pd.DataFrame, known: Mapping[str, float],
     ``reference``: an instrument column name or array, for a record taken in closed loop.
     """
     kinds, u, y, dt = input_output(recording)
-    fs = 1.0 / dt
     r = recording[reference].to_numpy(float) if isinstance(reference, str) else reference
-    f, h, coh = measured_frf(u, y, fs, segment_s, r)
-    band = (f >= band_hz[0]) & (f <= band_hz[1]) & (f > 0) & (coh >= MIN_COHERENCE)
-    if band.sum() < 3:
-        raise ValueError(f"{source}: fewer than 3 FRF lines with coherence >= {MIN_COHERENCE} "
-                         f"in {band_hz} Hz")
-    fb, hb = f[band], h[band]
-    gamma2 = np.minimum(coh[band], MAX_COHERENCE)
-    weight = gamma2 / (1.0 - gamma2)
-    d = dynamic_stiffness_factor(fb, kinds) / hb  # D (force) or D / m (base)
-    start = _linear_start(fb, d, weight)
-    wb = 2.0 * np.pi * fb
-    g = dynamic_stiffness_factor(fb, kinds)
-
+    f, h, coh = measured_frf(u, y, 1.0 / dt, segment_s, r)
+    fb, hb, weight = _fit_band(f, h, coh, band_hz, source)
     # a force input's known k and c_m are held (M is always fitted: the unit check needs it)
     hold_k = known.get("k") if kinds.input_kind == "force" else None
     hold_c = known.get("c_m") if kinds.input_kind == "force" else None
+    k, M, c, resid = _refine_log_frf(fb, hb, weight, kinds, hold_k, hold_c)
 
-    def unpack(x: NDArray) -> tuple[float, float, float]:
-        k = x[0] * scale[0] if hold_k is None else float(hold_k)
-        c = np.exp(x[2]) * scale[2] if hold_c is None else float(hold_c)
-        return k, np.exp(x[1]) * scale[1], c
-
-    def residuals(x: NDArray) -> NDArray:
-        k, M, c = unpack(x)
-        res = np.log(hb * (k - M * wb**2 + 1j * c * wb) / g)
-        return np.concatenate([res.real, res.imag]) * np.sqrt(np.tile(weight, 2))
-
-    scale = np.array([max(start[1] * wb.min() ** 2, 1e-12), start[1], start[2]])
-    x0 = np.array([start[0] / scale[0], 0.0, 0.0])
-    sol = optimize.least_squares(residuals, x0, bounds=([0.0, -np.inf, -np.inf], np.inf))
-    k, M, c = unpack(sol.x)
-    resid = float(np.sqrt(np.sum(sol.fun**2) / (2.0 * np.sum(weight))))
-
-    values = {"M": M, "m": np.nan, "k": k, "c_m": c}
-    fitted = ("M",) + (("k",) if hold_k is None else ()) + (("c_m",) if hold_c is None else ())
     if kinds.input_kind == "base_acc":
-        # the fit gives ratios to m: scale by a known parameter
-        ratios = {"M": M, "m": 1.0, "k": k, "c_m": c}
-        anchor = next((p for p in ("M", "m", "k", "c_m") if p in known and ratios[p] > 0), None)
-        if anchor is None:
-            raise ValueError(f"{source}: with a base_acc input the FRF gives only ratios to m: "
-                             "give M, m, k or c_m as known")
-        s = float(known[anchor]) / ratios[anchor]
-        values = {p: v * s for p, v in ratios.items()}
-        fitted = tuple(p for p in ("M", "m", "k", "c_m") if p != anchor)
+        values, fitted = _scale_base_ratios({"M": M, "m": 1.0, "k": k, "c_m": c}, known, kinds,
+                                            source, check_units)
+    else:
+        values = {"M": M, "m": np.nan, "k": k, "c_m": c}
+        fitted = ("M",) + (("k",) if hold_k is None else ()) + (("c_m",) if hold_c is None else ())
         if check_units:
-            m_over_M = 1.0 / M
-            estimates = {"m_over_M": m_over_M}
-            if m_over_M > 1.2:
-                raise DataError(source, f"the FRF gives m/M = {m_over_M:.3g} > 1, impossible "
-                                "(M = m + J (2 pi / l)^2): are base_acc and rel_acc in the same "
-                                "unit (m/s^2)? A column in g is 9.81 times too small")
-            if "M" in known and "m" in known:
-                check_scale(estimates, {"m_over_M": known["m"] / known["M"]}, kinds, source)
-    elif check_units:
-        check_scale({"M": M, "k": k, "c_m": c}, {p: known[p] for p in ("M",) if p in known},
-                    kinds, source)
+            check_scale({"M": M, "k": k, "c_m": c}, {p: known[p] for p in ("M",) if p in known},
+                        kinds, source)
     h_model = linear_frf(f, values["M"], values["m"] if kinds.input_kind == "base_acc" else 1.0,
                          values["k"], values["c_m"], kinds)
     return FrfFit(values={p: float(v) for p, v in values.items()}, fitted=fitted,

@@ -19,10 +19,14 @@ log = logging.getLogger("harvester.initial")
 DAMPING_FIT_BAND_HZ = (0.3, 10.0)
 
 
-#: Prior sd of beta sigma_v (sigma_v the RMS velocity) for a recording's device: a tanh law
-#: this steep reverses within 1/50 of the RMS velocity (under 2 % of the samples) and
-#: differs from a sign law no more than the data can tell.
-BETA_SIGMA_V = 50.0
+def beta_prior(sigma_v: float) -> PriorSpec:
+    """The tanh term's prior of beta on a device moving at an RMS velocity sigma_v (m/s)."""
+    from dataclasses import replace
+
+    from harvester.model.priors import REFERENCE_DEVICE
+    from harvester.model.terms import term
+    beta = next(p for p in term("tanh_friction").parameters if p.name == "beta")
+    return beta.prior_on(replace(REFERENCE_DEVICE, v=float(sigma_v)))
 
 
 def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
@@ -46,50 +50,71 @@ def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
 
     beta sets the velocity 1/beta over which the friction force reverses; Table 4's 100 +- 100
     s/m is beta sigma_v = 1.1 +- 1.1 on the paper's rig, but a friction law close to a sign law
-    (beta sigma_v of 75 on a test device, ``BETA_SIGMA_V``) would sit 25 sd in its tail. So
-    beta ~ N(0, BETA_SIGMA_V / sigma_v) truncated at 0, from smooth friction to a sign law.
+    (beta sigma_v of 75 on a test device) would sit 25 sd in its tail. So beta's prior is the
+    tanh term's own (``model/terms/tanh_friction.py``: log-uniform, beta sigma_v from 1/3 to
+    100) read at the recording's RMS velocity.
     """
     from harvester.inference.priors import default_prior
-    from harvester.study.paper import TABLE1, TABLE4
+    from harvester.study.paper import TABLE4
 
     unit = {n: default_prior(n).unit for n in ("c_m", "F_c", "beta")}
     specs = {n: PriorSpec(n, m_, s_, unit[n]) for n, (m_, s_) in TABLE4.items() if n in unit}
+    stated = _stated_priors(given or {}, specs)
+    try:
+        _set_damping_priors(specs, df, known, stated.get("F_c"), unit, source)
+    except (DataError, ValueError, np.linalg.LinAlgError) as err:
+        log.warning("FRF damping fit failed (%s); c_m, F_c and beta priors are Table 4's", err)
+    return {**specs, **stated}
+
+
+def _stated_priors(given: Mapping[str, Mapping[str, float]],
+                   specs: Mapping[str, PriorSpec]) -> dict[str, PriorSpec]:
+    """The priors ``given`` (config ``priors`` entries), with the unit and lower bound of
+    ``specs``' (or the library's default) prior of the same name where they give none."""
+    from harvester.inference.priors import default_prior
+    from harvester.study.paper import TABLE1
+
     stated = {}
-    for name, entry in (given or {}).items():
+    for name, entry in given.items():
         base = specs.get(name) or default_prior(name)
         stated[name] = prior_spec(name, {"unit": base.unit, "lower": base.lower, **entry},
                                   TABLE1)
+    return stated
+
+
+def _set_damping_priors(specs: dict[str, PriorSpec], df: pd.DataFrame,
+                        known: Mapping[str, float], measured_friction: PriorSpec | None,
+                        unit: Mapping[str, str], source: str) -> None:
+    """Set ``specs``' c_m (and, without a ``measured_friction``, F_c) from the recording's
+    FRF and beta from its RMS velocity (m/s), as :func:`recording_priors` describes. Raises
+    what the FRF fit raises; priors set before the failure stay set."""
     lead_in = min(256, len(df) // 4)
 
     def fit(friction: float) -> DampingFit:
         return fit_viscous_damping(df, known["M"], known["m"], known["k"], friction,
                                    DAMPING_FIT_BAND_HZ, lead_in=lead_in, source=source)
 
-    try:
-        if "F_c" in stated:
-            f_c = stated["F_c"].mean
-            measured = fit(f_c)
-            c_m, sigma_v = measured.c_m, measured.sigma_v
-            log.info("initial modelling: c_m = %.1f N s/m from the recording's FRF with the "
-                     "measured friction %.1f N", c_m, f_c)
-            specs["c_m"] = PriorSpec("c_m", c_m, TABLE4["c_m"][1], unit["c_m"])
-        else:
-            viscous = fit(0.0)
-            floor = 1e-6 * np.sqrt(known["k"] * known["M"])
-            c_v, sigma_v = max(viscous.c_m, floor), viscous.sigma_v
-            f_max = max(np.sqrt(np.pi / 2.0) * c_v * viscous.sigma_v, 1e-3)
-            log.info("initial modelling: the recording's FRF gives c_m = %.1f N s/m without "
-                     "friction (RMS velocity %.3g m/s); no measured friction, so c_m lies in "
-                     "0-%.1f N s/m and F_c in 0-%.2f N", c_v, viscous.sigma_v, c_v, f_max)
-            specs["c_m"] = PriorSpec("c_m", 0.0, c_v, unit["c_m"])
-            specs["F_c"] = PriorSpec("F_c", 0.0, float(f_max), unit["F_c"])
-        if sigma_v > 0.0:
-            specs["beta"] = PriorSpec("beta", 0.0, BETA_SIGMA_V / sigma_v, unit["beta"])
-            log.info("initial modelling: beta ~ N(0, %.0f s/m) truncated at 0 (beta sigma_v "
-                     "%g per sd)", BETA_SIGMA_V / sigma_v, BETA_SIGMA_V)
-    except (DataError, ValueError, np.linalg.LinAlgError) as err:
-        log.warning("FRF damping fit failed (%s); c_m, F_c and beta priors are Table 4's", err)
-    return {**specs, **stated}
+    if measured_friction is not None:
+        f_c = measured_friction.mean
+        measured = fit(f_c)
+        c_m, sigma_v = measured.c_m, measured.sigma_v
+        log.info("initial modelling: c_m = %.1f N s/m from the recording's FRF with the "
+                 "measured friction %.1f N", c_m, f_c)
+        specs["c_m"] = PriorSpec("c_m", c_m, specs["c_m"].sd, unit["c_m"])
+    else:
+        viscous = fit(0.0)
+        floor = 1e-6 * np.sqrt(known["k"] * known["M"])
+        c_v, sigma_v = max(viscous.c_m, floor), viscous.sigma_v
+        f_max = max(np.sqrt(np.pi / 2.0) * c_v * viscous.sigma_v, 1e-3)
+        log.info("initial modelling: the recording's FRF gives c_m = %.1f N s/m without "
+                 "friction (RMS velocity %.3g m/s); no measured friction, so c_m lies in "
+                 "0-%.1f N s/m and F_c in 0-%.2f N", c_v, viscous.sigma_v, c_v, f_max)
+        specs["c_m"] = PriorSpec("c_m", 0.0, c_v, unit["c_m"])
+        specs["F_c"] = PriorSpec("F_c", 0.0, float(f_max), unit["F_c"])
+    if sigma_v > 0.0:
+        specs["beta"] = beta_prior(sigma_v)
+        log.info("initial modelling: beta %s (the tanh term's prior at the RMS velocity "
+                 "%.3g m/s)", specs["beta"].describe(), sigma_v)
 
 
 #: Lowest frequency (Hz) of the FRF fit that sets the priors of unknown M, m, k, c_m, and the

@@ -147,7 +147,36 @@ def _step_source(terms: tuple[Term, ...], driver: str) -> str:
     return "\n".join(body)
 
 
+#: The servo driver's pieces of ``integrate``: the position loop's force at every sample.
+_SERVO = dict(
+    head=("def integrate(qg, dist, dt, q0, gtau, kp, kv, n_sub, h, P, out_acc, out_z, "
+          "out_v, out_f, ok):"),
+    prologue=("    n = qg.shape[0]\n    uu = np.empty(C)\n    q1 = np.empty(C)\n"
+              "    q2 = np.empty(C)\n    for c in range(C):\n"
+              "        q1[c] = q0\n        q2[c] = q0\n        x0[c] = q0"),
+    sample=("        for c in range(C):\n"
+            "            q = x0[c]\n"
+            "            uu[c] = gtau * (kv * (kp * (qg[i] - q) - (q - q2[c]) / (2.0 * dt))"
+            " + dist[i])\n"
+            "            q2[c] = q1[c]\n            q1[c] = q\n"
+            "        if out_f.shape[0] > 0:\n"
+            "            for c in range(C):\n"
+            "                out_f[i, c] = uu[c]\n"),
+    interval="pass", slope="", inputs="", last_u="uu[c]")
+
+#: The base and force drivers' pieces: the input sampled, linearly interpolated in a sample.
+_SAMPLED = dict(
+    head="def integrate(u, n_sub, h, P, out_acc, out_z, out_v, ok):",
+    prologue="    n = u.shape[0]", sample="", interval="ui = u[i]",
+    slope="du = (u[i + 1] - ui) / n_sub",
+    inputs=("            ua = ui + du * s\n            ub = ua + 0.5 * du\n"
+            "            uc = ua + du\n"),
+    last_u="u[n - 1]")
+
+
 def _integrate_source(terms: tuple[Term, ...], driver: str) -> str:
+    """``integrate``: RK4 over a block of particles (struct of arrays), the states kept
+    finite (a particle beyond ``BLOW_UP`` is flagged and reset), z, z', z'' written out."""
     params, states = _names(terms)
     n = len(states)
     ind = " " * 16
@@ -158,39 +187,17 @@ def _integrate_source(terms: tuple[Term, ...], driver: str) -> str:
     step = "\n".join(ind + line for line in _step_source(terms, driver).splitlines())
     out_rhs = ", ".join(f"x{j}[c]" for j in range(n)) + ", " + \
         ", ".join(f"p_{p}[c]" for p in params)
-    if driver == "servo":
-        head = ("def integrate(qg, dist, dt, q0, gtau, kp, kv, n_sub, h, P, out_acc, out_z, "
-                "out_v, out_f, ok):")
-        prologue = ("    n = qg.shape[0]\n    uu = np.empty(C)\n    q1 = np.empty(C)\n"
-                    "    q2 = np.empty(C)\n    for c in range(C):\n"
-                    "        q1[c] = q0\n        q2[c] = q0\n        x0[c] = q0")
-        sample = ("        for c in range(C):\n"
-                  "            q = x0[c]\n"
-                  "            uu[c] = gtau * (kv * (kp * (qg[i] - q) - (q - q2[c]) / (2.0 * dt))"
-                  " + dist[i])\n"
-                  "            q2[c] = q1[c]\n            q1[c] = q\n"
-                  "        if out_f.shape[0] > 0:\n"
-                  "            for c in range(C):\n"
-                  "                out_f[i, c] = uu[c]\n")
-        inputs = ""
-        last_u = "uu[c]"
-    else:
-        head = "def integrate(u, n_sub, h, P, out_acc, out_z, out_v, ok):"
-        prologue = "    n = u.shape[0]"
-        sample = ""
-        inputs = ("            ua = ui + du * s\n            ub = ua + 0.5 * du\n"
-                  "            uc = ua + du\n")
-        last_u = "u[n - 1]"
-    return f'''{head}
+    d = _SERVO if driver == "servo" else _SAMPLED
+    return f"""{d["head"]}
     C = P.shape[1]
 {load}
 {init}
-{prologue}
+{d["prologue"]}
     scratch = np.empty(C)
     half = 0.5 * h
     sixth = h / 6.0
     for i in range(n):
-{sample}        if out_z.shape[0] > 0:
+{d["sample"]}        if out_z.shape[0] > 0:
             for c in range(C):
                 out_z[i, c] = x0[c]
         if out_v.shape[0] > 0:
@@ -199,19 +206,19 @@ def _integrate_source(terms: tuple[Term, ...], driver: str) -> str:
         acc_row = out_acc[i] if out_acc.shape[0] > 0 else scratch
         if i == n - 1:
             for c in range(C):
-                acc_row[c] = rhs({last_u}, {out_rhs})[0]
+                acc_row[c] = rhs({d["last_u"]}, {out_rhs})[0]
             break
-        {"ui = u[i]" if driver != "servo" else "pass"}
-        {"du = (u[i + 1] - ui) / n_sub" if driver != "servo" else ""}
+        {d["interval"]}
+        {d["slope"]}
         for s in range(n_sub):
-{inputs}            row = acc_row if s == 0 else scratch
+{d["inputs"]}            row = acc_row if s == 0 else scratch
             for c in range(C):
 {step}
         for c in range(C):
             if not ({check}):
                 ok[c] = False
                 {reset}
-'''
+"""
 
 
 def source(terms: tuple[str, ...], driver: str) -> str:

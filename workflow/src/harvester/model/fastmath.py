@@ -69,22 +69,29 @@ def _reduce(x):
     return t, k, r
 
 
+#: Horner coefficients, highest power first, of (exp(r) - 1 - r) / r^2 = sum r^j / (j + 2)!
+#: to r^11 (exp(r) - 1 to r^13).
+_EXPM1_SERIES = (1.0 / 6227020800.0, 1.0 / 479001600.0, 1.0 / 39916800.0, 1.0 / 3628800.0,
+                 1.0 / 362880.0, 1.0 / 40320.0, 1.0 / 5040.0, 1.0 / 720.0, 1.0 / 120.0,
+                 1.0 / 24.0, 1.0 / 6.0, 0.5)
+#: Horner coefficients, highest power first, of atanh(s) / s = sum s^(2j) / (2j + 1) to s^22.
+_ATANH_SERIES = (1.0 / 23.0, 1.0 / 21.0, 1.0 / 19.0, 1.0 / 17.0, 1.0 / 15.0, 1.0 / 13.0,
+                 1.0 / 11.0, 1.0 / 9.0, 1.0 / 7.0, 1.0 / 5.0, 1.0 / 3.0, 1.0)
+
+
+@nb.njit(error_model="numpy", cache=True)
+def _horner(coefficients, x):
+    """The polynomial with ``coefficients`` (highest power first) at x, in Horner form."""
+    p = coefficients[0]
+    for j in range(1, len(coefficients)):
+        p = p * x + coefficients[j]
+    return p
+
+
 @nb.njit(error_model="numpy", cache=True)
 def _expm1_reduced(r):
     """exp(r) - 1 for |r| <= ln 2 / 2 (Taylor series to r^13, Horner form)."""
-    p = 1.0 / 6227020800.0
-    p = p * r + 1.0 / 479001600.0
-    p = p * r + 1.0 / 39916800.0
-    p = p * r + 1.0 / 3628800.0
-    p = p * r + 1.0 / 362880.0
-    p = p * r + 1.0 / 40320.0
-    p = p * r + 1.0 / 5040.0
-    p = p * r + 1.0 / 720.0
-    p = p * r + 1.0 / 120.0
-    p = p * r + 1.0 / 24.0
-    p = p * r + 1.0 / 6.0
-    p = p * r + 0.5
-    return (p * r) * r + r
+    return (_horner(_EXPM1_SERIES, r) * r) * r + r
 
 
 @nb.njit(error_model="numpy", cache=True)
@@ -127,19 +134,7 @@ def log(x):
     m = 0.5 * m if big else m
     k = k + 1.0 if big else k
     s = (m - 1.0) / (m + 1.0)
-    s2 = s * s
-    p = 1.0 / 23.0
-    p = p * s2 + 1.0 / 21.0
-    p = p * s2 + 1.0 / 19.0
-    p = p * s2 + 1.0 / 17.0
-    p = p * s2 + 1.0 / 15.0
-    p = p * s2 + 1.0 / 13.0
-    p = p * s2 + 1.0 / 11.0
-    p = p * s2 + 1.0 / 9.0
-    p = p * s2 + 1.0 / 7.0
-    p = p * s2 + 1.0 / 5.0
-    p = p * s2 + 1.0 / 3.0
-    p = p * s2 + 1.0
+    p = _horner(_ATANH_SERIES, s * s)
     return k * _LN2_HI + (2.0 * s * p + k * _LN2_LO)
 
 

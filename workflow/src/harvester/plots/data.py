@@ -18,9 +18,8 @@ from matplotlib.figure import Figure  # noqa: E402
 
 from harvester.initial.damping import DampingFit  # noqa: E402
 from harvester.data.signals import psd  # noqa: E402
+from harvester.plots.style import MEASURED, MODEL, NOTE_SIZE, save_figure  # noqa: E402
 
-MEASURED = "0.6"      # grey: measured / unfiltered
-MODEL = "black"       # black: filtered / model
 SIMULATED = "Virtual rig (simulated recordings), not the paper's measurements."
 
 #: The rocking mode of the mass shows between these frequencies (Hz), paper Figure 4.
@@ -28,11 +27,9 @@ ROCKING_BAND_HZ = (30.0, 80.0)
 
 
 def _finish(fig: Figure, path: str | Path) -> None:
-    """Add the simulated-recordings footnote, save at 150 dpi and close."""
-    fig.text(0.01, 0.005, SIMULATED, fontsize=7, style="italic", va="bottom")
-    fig.tight_layout(rect=(0.0, 0.03, 1.0, 1.0))
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
+    """Add the simulated-recordings footnote, save (``style.save_figure``) and close."""
+    fig.text(0.01, 0.005, SIMULATED, fontsize=NOTE_SIZE, style="italic", va="bottom")
+    save_figure(fig, path, rect=(0.0, 0.03, 1.0, 1.0))
 
 
 def fig04_psd(raw_df: pd.DataFrame, filtered_df: pd.DataFrame, fs: float, cutoff: float,

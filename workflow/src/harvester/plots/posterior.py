@@ -10,7 +10,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from harvester.data.fileio import atomic_path  # noqa: E402
+from harvester.plots.style import HIGHLIGHT, MEASURED, MODEL, TITLE_SIZE, save_figure  # noqa: E402
 
 SIMULATED_NOTE = "recordings: virtual rig (simulated)"
 UNITS = {"c_m": "N s/m", "F_c": "N", "beta": "s/m", "sigma": "m/s$^2$"}
@@ -38,26 +38,23 @@ def pair_plot(samples: np.ndarray, names: list[str], path: str | Path, title: st
                 ax.axis("off")
                 continue
             if i == j:
-                ax.hist(samples[:, i], bins=30, color="0.6", edgecolor="0.3")
-                _mark_1d(ax, names[i], paper, "k", "paper")
-                _mark_1d(ax, names[i], truth, "tab:red", "rig truth")
+                ax.hist(samples[:, i], bins=30, color=MEASURED, edgecolor="0.3")
+                _mark_1d(ax, names[i], paper, MODEL, "paper")
+                _mark_1d(ax, names[i], truth, HIGHLIGHT, "rig truth")
             else:
                 ax.plot(samples[:, j], samples[:, i], ".", color="0.45", ms=2, alpha=0.6)
-                _mark_2d(ax, names[j], names[i], paper, "k", "x")
-                _mark_2d(ax, names[j], names[i], truth, "tab:red", "+")
+                _mark_2d(ax, names[j], names[i], paper, MODEL, "x")
+                _mark_2d(ax, names[j], names[i], truth, HIGHLIGHT, "+")
             if i == n - 1:
                 ax.set_xlabel(label(names[j], units))
             if j == 0 and i > 0:
                 ax.set_ylabel(label(names[i], units))
-    handles = [plt.Line2D([], [], color="k", marker="x", ls="--", label="paper (posterior mean)"),
-               plt.Line2D([], [], color="tab:red", marker="+", ls=":", label="virtual rig truth")]
+    handles = [plt.Line2D([], [], color=MODEL, marker="x", ls="--", label="paper (posterior mean)"),
+               plt.Line2D([], [], color=HIGHLIGHT, marker="+", ls=":", label="virtual rig truth")]
     if paper or truth:
         fig.legend(handles=handles, loc="upper right", frameon=False)
-    fig.suptitle(f"{title}\n{note}", fontsize=10)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=120, format="png")
-    plt.close(fig)
+    fig.suptitle(f"{title}\n{note}", fontsize=TITLE_SIZE)
+    save_figure(fig, path)
 
 
 def _mark_1d(ax, name, values, color, what) -> None:  # noqa: ANN001

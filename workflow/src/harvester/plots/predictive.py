@@ -10,8 +10,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from harvester.data.fileio import atomic_path  # noqa: E402
 from harvester.plots.posterior import SIMULATED_NOTE  # noqa: E402
+from harvester.plots.style import (BOUNDS, LEGEND_SIZE, MEASURED, MODEL, TITLE_SIZE,  # noqa: E402
+                                   save_figure)
 from harvester.inference.predictive import PredictiveBand  # noqa: E402
 
 
@@ -27,20 +28,18 @@ def response_figure(band: PredictiveBand, measured: np.ndarray, path: str | Path
     width = 11 if window is None or (window[1] - window[0]) > 20 else 9
     fig, ax = plt.subplots(figsize=(width, 4))
     mean = band.mean[sel]
-    for bounds, color, alpha in (("predictive", "tab:blue", 0.18), ("parameter", "tab:orange", 0.45)):
+    for bounds in ("predictive", "parameter"):
+        color, alpha = BOUNDS[bounds]
         sd = band.sd(bounds)[sel]
         what = "parameters + likelihood sigma" if bounds == "predictive" else "parameters only"
         ax.fill_between(t[sel], mean - k * sd, mean + k * sd, color=color, alpha=alpha, lw=0,
                         label=f"mean $\\pm${k:g} sd ({what})")
     lw = 0.6 if window is None else 1.0
-    ax.plot(t[sel], measured[sel], color="0.6", lw=lw, label=measured_label)
-    ax.plot(t[sel], mean, color="k", lw=lw, label="model mean")
+    ax.plot(t[sel], measured[sel], color=MEASURED, lw=lw, label=measured_label)
+    ax.plot(t[sel], mean, color=MODEL, lw=lw, label="model mean")
     ax.set_xlabel("time (s)")
     ax.set_ylabel(ylabel)
-    ax.set_title(f"{title}\n{note}", fontsize=10)
-    ax.legend(loc="upper right", fontsize=8, ncol=2, frameon=False)
+    ax.set_title(f"{title}\n{note}", fontsize=TITLE_SIZE)
+    ax.legend(loc="upper right", fontsize=LEGEND_SIZE, ncol=2, frameon=False)
     ax.margins(x=0)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=120, format="png")
-    plt.close(fig)
+    save_figure(fig, path)

@@ -21,13 +21,15 @@ log = logging.getLogger("harvester.study.dataset")
 def write_loaded_records(rig_cfg: Mapping[str, Any], out: Path) -> list[str]:
     """Write every record of ``rig_cfg['loaded_records']`` (none if absent); their file names.
 
-    Each holds ai0, ai1 and the voltage channel ai2 (``harvester.synthetic.electrical``).
+    Each holds ai0, ai1 and the line-voltage channels ai2 (v_ab) and ai3 (v_bc)
+    (``harvester.synthetic.electrical``).
     """
     names: list[str] = []
     for record in rig_cfg.get("loaded_records", {}):
         start = time.perf_counter()
         sim = electrical.simulate_loaded_record(rig_cfg, record)
-        frame = pd.DataFrame({"time": sim.time, "ai0": sim.ai0, "ai1": sim.ai1, "ai2": sim.ai2})
+        frame = pd.DataFrame({"time": sim.time, "ai0": sim.ai0, "ai1": sim.ai1, "ai2": sim.ai2,
+                              "ai3": sim.ai3})
         meta = daq.loaded_record_metadata(rig_cfg, record, len(frame), sim.seed, sim.load_ohm)
         daq.write_raw_record(frame, out / f"{record}.csv", out / f"{record}.json", meta)
         names += [f"{record}.csv", f"{record}.json"]

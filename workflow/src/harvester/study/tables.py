@@ -111,6 +111,8 @@ def write_table_png(df: pd.DataFrame, path: str | Path, title: str,
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from harvester.plots.style import save_figure
+
     cells = [[_fmt(x) for x in row] for row in df.itertuples(index=False)]
     lines = [textwrap.fill(f"{i}. {n}", width=120, subsequent_indent="   ")
              for i, n in enumerate([*notes, SIMULATED_NOTE], start=1)]
@@ -127,5 +129,4 @@ def write_table_png(df: pd.DataFrame, path: str | Path, title: str,
     table.set_fontsize(9)
     ax_n.text(0.0, 1.0, "\n".join(lines), fontsize=7, va="top", ha="left",
               transform=ax_n.transAxes)
-    fig.savefig(path, dpi=150, bbox_inches="tight")
-    plt.close(fig)
+    save_figure(fig, path, tight=False, crop=True)

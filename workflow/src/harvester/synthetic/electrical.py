@@ -37,8 +37,10 @@ viscous: F_e = c_e z' with
 since sum_k sin^2(p theta - 2 pi k / 3) = 3/2. Energy: F_e z' = (R_s + R_L) sum_k i_k^2 +
 d/dt (L_s / 2 sum_k i_k^2).
 
-The recorded voltage is line-to-line, between generator terminals a and b:
-v_ab = R_L (i_a - i_b) (= e_a - e_b in open circuit). The paper's voltmeter measured "the
+The recorded voltages are line-to-line, between generator terminals a and b and between b
+and c: v_ab = R_L (i_a - i_b), v_bc = R_L (i_b - i_c) (= e_a - e_b, e_b - e_c in open
+circuit). Two line voltages give the space vector of the three, whose magnitude does not
+depend on the rotor angle (one line voltage alone does: ``docs/electrical.md``). The paper's voltmeter measured "the
 voltage across the generator terminals, that is, the load resistance"; a voltage across the
 terminals is between two of them, and with a star load it is the voltage across the two load
 resistors of those phases in series; the star point need not be reachable.
@@ -301,7 +303,7 @@ class LoadedMotion:
 
     z (m), v = z' (m/s), acc = z'' (m/s^2), friction f (N), stuck; phase currents i_a, i_b,
     i_c (A), electrical force F_e (N), rotor angle theta_m (rad) and speed omega_m (rad/s),
-    the line-to-line terminal voltage v_ab (V); ``load_ohm`` None in open circuit.
+    the line-to-line terminal voltages v_ab and v_bc (V); ``load_ohm`` None in open circuit.
     """
 
     z: Array
@@ -316,6 +318,7 @@ class LoadedMotion:
     omega_m: Array
     voltage: Array
     load_ohm: float | None
+    voltage_bc: Array | None = None
 
     @property
     def i_c(self) -> Array:
@@ -359,11 +362,12 @@ def simulate_loaded_motion(y_dd: Array, fs: float, dev: rig.Device, gen: Generat
     theta = theta0 + gen.screw_ratio * z
     omega = gen.screw_ratio * v
     if coupled:
-        voltage = load_ohm * (ia - ib)
+        voltage, voltage_bc = load_ohm * (ia - ib), load_ohm * (2.0 * ib + ia)
     else:
         emf = back_emf(gen, theta, omega)
-        voltage = emf[0] - emf[1]
-    return LoadedMotion(z, v, a, f, stuck, ia, ib, fe, theta, omega, voltage, load_ohm)
+        voltage, voltage_bc = emf[0] - emf[1], emf[1] - emf[2]
+    return LoadedMotion(z, v, a, f, stuck, ia, ib, fe, theta, omega, voltage, load_ohm,
+                        voltage_bc)
 
 
 # --------------------------------------------------------------------------- records
@@ -380,8 +384,9 @@ def voltage_sensor_volts(voltage: Array, sensor: Mapping[str, Any]) -> Array:
 class LoadedRecordSimulation:
     """One simulated loaded record: three channel voltages at the output rate and the truth.
 
-    ai0, ai1 as ``rig.RecordSimulation``; ai2 the voltage sensor's output (V). ``truth`` adds to
-    the rig's (base_acc, rel_acc, rocking, z, v, stuck): ``voltage`` (v_ab, V) and
+    ai0, ai1 as ``rig.RecordSimulation``; ai2, ai3 the outputs (V) of the voltage sensors on
+    v_ab and v_bc. ``truth`` adds to the rig's (base_acc, rel_acc, rocking, z, v, stuck):
+    ``voltage`` (v_ab, V), ``voltage_bc`` (v_bc, V) and
     ``electrical_force`` (F_e, N) through the anti-alias filter without noise; ``i_a``,
     ``i_b`` (A) sampled; ``theta0`` (rad), ``load_ohm`` (None in open circuit), ``substeps``.
     """
@@ -395,6 +400,7 @@ class LoadedRecordSimulation:
     ai2: Array
     load_ohm: float | None
     truth: dict[str, Any]
+    ai3: Array | None = None
 
 
 def simulate_loaded_record(rig_cfg: Mapping[str, Any], name: str,
@@ -402,15 +408,18 @@ def simulate_loaded_record(rig_cfg: Mapping[str, Any], name: str,
     """Run the rig with the generator for loaded record ``name`` (``rig.loaded_records``).
 
     The shaker, accelerometers, rocking mode, anti-alias filter and ADC are the rig's; the
-    voltage sensor adds its own noise (``voltage_sensor.noise_V`` RMS over the DAQ band) and
-    the rotor starts at a random angle. The rocking mode is driven by the whole screw force,
+    voltage sensors (one per line voltage, v_ab and v_bc) add their own noise
+    (``voltage_sensor.noise_V`` RMS over the DAQ band) and the rotor starts at a random angle.
+    The v_bc sensor's noise is a seventh stream, so the first six and ai0-ai2 do not depend
+    on it. The rocking mode is driven by the whole screw force,
     friction plus F_e.
     """
     spec = rig_cfg["loaded_records"][name]
     duration = float(spec["duration_s"] if duration_s is None else duration_s)
     grid = rig.record_grid(rig_cfg, duration)
     seed = loaded_record_seed(rig_cfg, name)
-    rng_exc, rng_base, rng_mass, rng_ball, rng_volt, rng_angle = rig.record_streams(seed, 6)
+    rng_exc, rng_base, rng_mass, rng_ball, rng_volt, rng_angle, rng_volt_bc = \
+        rig.record_streams(seed, 7)
     load = load_of(rig_cfg, name)
     gen = Generator.from_config(rig_cfg)
     dev = rig.Device.from_config(rig_cfg)
@@ -427,6 +436,8 @@ def simulate_loaded_record(rig_cfg: Mapping[str, Any], name: str,
     sd = rig.noise_rms_internal(float(sensor["noise_V"]), grid.oversample)
     measured = motion.voltage + sd * rng_volt.standard_normal(motion.voltage.size)
     ai2 = rig.adc(rig_cfg, grid, voltage_sensor_volts(measured, sensor))
+    measured_bc = motion.voltage_bc + sd * rng_volt_bc.standard_normal(motion.voltage.size)
+    ai3 = rig.adc(rig_cfg, grid, voltage_sensor_volts(measured_bc, sensor))
 
     os_, n_out, at = grid.oversample, grid.n_out, grid.at
     truth: dict[str, Any] = {
@@ -434,13 +445,14 @@ def simulate_loaded_record(rig_cfg: Mapping[str, Any], name: str,
         "rel_acc": rig.decimate(motion.acc, os_, n_out),
         "rocking": rig.decimate(rock, os_, n_out),
         "voltage": rig.decimate(motion.voltage, os_, n_out),
+        "voltage_bc": rig.decimate(motion.voltage_bc, os_, n_out),
         "electrical_force": rig.decimate(motion.force, os_, n_out),
         "z": motion.z[at], "v": motion.v[at], "stuck": motion.stuck[at],
         "i_a": motion.i_a[at], "i_b": motion.i_b[at],
         "theta0": theta0, "load_ohm": load, "substeps": gen.substeps(load, 1.0 / grid.fs)}
     return LoadedRecordSimulation(name=name, seed=seed, sampling_rate_hz=grid.fs_out,
                                   time=np.arange(n_out) / grid.fs_out, ai0=ai0, ai1=ai1,
-                                  ai2=ai2, load_ohm=load, truth=truth)
+                                  ai2=ai2, load_ohm=load, truth=truth, ai3=ai3)
 
 
 def electrical_truth(rig_cfg: Mapping[str, Any]) -> dict[str, Any]:

@@ -152,22 +152,9 @@ def _sgn_eps(w, eps):
 
 
 @nb.njit(cache=True)
-def _rhs(s, yb, dev, code, amp, shape, ds):
-    """ds = time derivative of the state s; returns the mass's relative acceleration z''.
-
-    dev = (M, m, k, c_m, F_c, beta); s = (z, z', extra states of the law).
-    """
-    M, m, k, c, Fc, beta = dev[0], dev[1], dev[2], dev[3], dev[4], dev[5]
-    if code == EXTRA_MASS:
-        M += amp
-        m += amp
-    z = s[0]
-    v = s[1]
-    w = v
-    if code == BACKLASH:
-        w = s[3]  # screw-side velocity
-    f_screw = c * w + Fc * math.tanh(beta * w)
-    f_mass = k * z
+def _law_forces(s, yb, m, z, v, w, f_screw, f_mass, code, amp, shape, ds):
+    """(f_screw, f_mass) in N with the generator law ``code`` added (module docstring's
+    forms); a law with states of its own writes their rates into ds[2:]."""
     if code == KARNOPP:
         if abs(w) < shape[0]:  # stuck: friction holds the applied force up to breakaway
             applied = -m * yb - f_mass - f_screw
@@ -202,19 +189,19 @@ def _rhs(s, yb, dev, code, amp, shape, ds):
         f_screw += amp * u_acc
         ds[2] = s[3]
         ds[3] = u_acc
-    ds[0] = v
-    if code != BACKLASH:
-        acc = (-m * yb - f_screw - f_mass) / M
-        ds[1] = acc
-        return acc
-    # backlash: mass m (z, z') and screw side J = M - m (r, r' = s[2], s[3]) in contact across
-    # a gap amp: delta = |z - r| - gap; Tsuji contact force k_c delta^1.5 + c_c delta^0.25
-    # delta' (continuous at touch-down), compressive only
+    return f_screw, f_mass
+
+
+@nb.njit(cache=True)
+def _backlash_rates(s, yb, M, m, f_screw, f_mass, gap, shape, ds):
+    """z'' (m/s^2) of the mass m (z, z') and the screw side J = M - m (r, r' = s[2], s[3]) in
+    contact across a gap (m): delta = |z - r| - gap; Tsuji contact force k_c delta^1.5 +
+    c_c delta^0.25 delta' (continuous at touch-down), compressive only. Writes ds[1:]."""
     jq = M - m
-    d = z - s[2]
-    dd = v - s[3]
+    d = s[0] - s[2]
+    dd = s[1] - s[3]
     sg = 1.0 if d >= 0 else -1.0
-    pen = abs(d) - amp
+    pen = abs(d) - gap
     fb = 0.0
     if pen > 0.0:
         fb = sg * max(shape[0] * pen ** 1.5 + shape[1] * pen ** 0.25 * sg * dd, 0.0)
@@ -222,6 +209,31 @@ def _rhs(s, yb, dev, code, amp, shape, ds):
     ds[1] = acc
     ds[2] = s[3]
     ds[3] = (fb - f_screw) / jq
+    return acc
+
+
+@nb.njit(cache=True)
+def _rhs(s, yb, dev, code, amp, shape, ds):
+    """ds = time derivative of the state s; returns the mass's relative acceleration z''.
+
+    dev = (M, m, k, c_m, F_c, beta); s = (z, z', extra states of the law).
+    """
+    M, m, k, c, Fc, beta = dev[0], dev[1], dev[2], dev[3], dev[4], dev[5]
+    if code == EXTRA_MASS:
+        M += amp
+        m += amp
+    z = s[0]
+    v = s[1]
+    w = v
+    if code == BACKLASH:
+        w = s[3]  # screw-side velocity
+    f_screw, f_mass = _law_forces(s, yb, m, z, v, w, c * w + Fc * math.tanh(beta * w), k * z,
+                                  code, amp, shape, ds)
+    ds[0] = v
+    if code == BACKLASH:
+        return _backlash_rates(s, yb, M, m, f_screw, f_mass, amp, shape, ds)
+    acc = (-m * yb - f_screw - f_mass) / M
+    ds[1] = acc
     return acc
 
 
@@ -612,16 +624,9 @@ class Scenario:
     contribution: np.ndarray  # LP[z''(with) - z''(without)] (m/s^2), zeros when effect-free
 
 
-def make_scenario(effect: str, ratio: float, seed: int, settings: ScenarioSettings,
-                  device: Device | None = None, rig_cfg: Mapping[str, Any] | None = None,
-                  masking: bool = True) -> Scenario:
-    """Generate one scenario: calibrate the effect's strength, then record with noise.
-
-    ``device`` defaults to :class:`Device` (the Table 5 tanh device or its linear version, by
-    the effect's baseline), or the config's rig device when ``rig_cfg`` is given. ``masking``:
-    also compute the share of the contribution the baseline's parameters absorb (3-6 more
-    simulations).
-    """
+def _scenario_device(effect: str, ratio: float, device: Device | None,
+                     rig_cfg: Mapping[str, Any] | None) -> tuple[Device, str]:
+    """(device, baseline) of a scenario, checked against its effect and ratio."""
     baseline = baseline_of(effect)
     if device is None:
         device = (Device.from_rig(rig_cfg, baseline) if rig_cfg is not None
@@ -632,9 +637,93 @@ def make_scenario(effect: str, ratio: float, seed: int, settings: ScenarioSettin
         raise ValueError(f"effect-free scenario {effect} needs ratio 0, got {ratio}")
     if effect not in EFFECT_FREE and not ratio > 0:
         raise ValueError(f"scenario {effect} needs a positive ratio, got {ratio}")
+    return device, baseline
+
+
+def _calibrated_effect(fam: Family, effect: str, seed: int, settings: ScenarioSettings,
+                       exc: Excitation, device: Device, without: np.ndarray,
+                       z_fine: np.ndarray, target: float, noise_rms: float
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+    """The effect at the strength whose contribution's RMS is ``target`` (m/s^2): (z'' on the
+    simulation grid, raw and low-passed contribution on the output grid, truth entries)."""
+    motion = {"z": exc.decimate(z_fine), "beta": device.beta}
+    srng = shape_rng(settings, effect, seed)
+    shape = fam.shapes(srng, motion)
+    sign = float(srng.choice([-1.0, 1.0])) if fam.signed else 1.0
+    contrib = Contribution(fam, fam.shape_vector(shape), exc, device, settings, without)
+    strength, _, evals = calibrate(
+        lambda s: contrib.rms(sign * s if fam.signed else s), target, fam.guess)
+    strength *= sign
+    acc_fine = contrib.fine(strength)
+    raw, contribution = contrib.series(strength)
+    truth = {
+        "form": fam.form, "library_form": fam.library_form, "strength_name": fam.strength,
+        "strength_unit": fam.unit, "strength": float(strength), "shape": shape,
+        "calibration_evaluations": evals,
+        "zero_strength_ratio": (contrib.rms(0.0) / noise_rms if fam.code == BACKLASH else 0.0),
+    }
+    return acc_fine, raw, contribution, truth
+
+
+def _how_it_hides(contribution: np.ndarray, raw: np.ndarray, settings: ScenarioSettings,
+                  noise_rms: float) -> dict[str, Any]:
+    """The truth's measures of how visible the contribution is (module docstring)."""
+    c_w = contribution[settings.lead_in:]
+    c_rms = float(np.sqrt(np.mean(c_w**2)))
+    raw_energy = float(np.sum(raw[settings.lead_in:] ** 2))
+    peak = float(np.max(np.abs(c_w))) / noise_rms if c_rms > 0 else 0.0
+    return {
+        "contribution_rms": c_rms,
+        "contribution_ratio": c_rms / noise_rms,
+        "peak_to_noise": peak,
+        "window_rms_to_noise": _window_rms_max(c_w, int(round(settings.fs))) / noise_rms,
+        "filter_removed_share": (1.0 - float(np.sum(c_w**2)) / raw_energy
+                                 if raw_energy > 0 else 0.0),
+        "invisible": bool(peak < INVISIBLE_PEAK),
+    }
+
+
+def _unabsorbed(exc: Excitation, device: Device, settings: ScenarioSettings,
+                contribution: np.ndarray, noise_rms: float) -> dict[str, Any]:
+    """What the baseline's c_m, F_c, beta absorb of the contribution (linearised least
+    squares over the analysis window) and the RMS left, over the noise RMS."""
+    c_w = contribution[settings.lead_in:]
+    jac = _baseline_sensitivities(exc, device, settings)[settings.lead_in:]
+    beta, *_ = np.linalg.lstsq(jac, c_w, rcond=None)
+    left = c_w - jac @ beta
+    return {"unabsorbed_to_noise": float(np.sqrt(np.mean(left**2))) / noise_rms,
+            "absorbed_shift": dict(zip(["c_m", "F_c", "beta"], (-beta).tolist()))}
+
+
+def _record(exc: Excitation, acc_fine: np.ndarray, settings: ScenarioSettings,
+            rng_base: np.random.Generator, rng_mass: np.random.Generator
+            ) -> tuple[pd.DataFrame, float]:
+    """(recording, realised RMS of the noise in its z'' over the analysis window, m/s^2): both
+    sensors' noise, then the study's zero-phase low-pass on both channels."""
+    y_out = exc.decimate(exc.y_fine)
+    z_out = exc.decimate(acc_fine)
+    base = y_out + settings.noise_m_s2 * rng_base.standard_normal(settings.n)
+    mass = y_out + z_out + settings.noise_m_s2 * rng_mass.standard_normal(settings.n)
+    lp = dict(fs=settings.fs, cutoff_hz=settings.lowpass_hz, order=settings.filter_order)
+    noise_rel = lowpass((mass - y_out - z_out) - (base - y_out), **lp)
+    rec = pd.DataFrame({"time": np.arange(settings.n) / settings.fs,
+                        "base_acc": lowpass(base, **lp), "rel_acc": lowpass(mass - base, **lp)})
+    return rec, float(np.sqrt(np.mean(noise_rel[settings.lead_in:] ** 2)))
+
+
+def make_scenario(effect: str, ratio: float, seed: int, settings: ScenarioSettings,
+                  device: Device | None = None, rig_cfg: Mapping[str, Any] | None = None,
+                  masking: bool = True) -> Scenario:
+    """Generate one scenario: calibrate the effect's strength, then record with noise.
+
+    ``device`` defaults to :class:`Device` (the Table 5 tanh device or its linear version, by
+    the effect's baseline), or the config's rig device when ``rig_cfg`` is given. ``masking``:
+    also compute the share of the contribution the baseline's parameters absorb (3-6 more
+    simulations).
+    """
+    device, baseline = _scenario_device(effect, ratio, device, rig_cfg)
     exc, rng_base, rng_mass = excitation(settings, seed)
     noise_rms = settings.noise_rms()
-    target = ratio * noise_rms
     fam = FAMILIES.get(effect)
     without, z_fine = device_motion(exc.y_fine, exc.fs_fine, device)
     truth: dict[str, Any] = {
@@ -643,58 +732,16 @@ def make_scenario(effect: str, ratio: float, seed: int, settings: ScenarioSettin
         "noise_rms": noise_rms, "sensor_noise_m_s2": settings.noise_m_s2,
         "settings": asdict(settings),
     }
-    acc_fine = without
-    contribution = np.zeros(settings.n)
-    raw = np.zeros(settings.n)
+    acc_fine, raw, contribution = without, np.zeros(settings.n), np.zeros(settings.n)
     if fam is not None:
-        motion = {"z": exc.decimate(z_fine), "beta": device.beta}
-        srng = shape_rng(settings, effect, seed)
-        shape = fam.shapes(srng, motion)
-        sign = float(srng.choice([-1.0, 1.0])) if fam.signed else 1.0
-        shape_vec = fam.shape_vector(shape)
-        contrib = Contribution(fam, shape_vec, exc, device, settings, without)
-        strength, achieved, evals = calibrate(
-            lambda s: contrib.rms(sign * s if fam.signed else s), target, fam.guess)
-        strength *= sign
-        acc_fine = contrib.fine(strength)
-        raw, contribution = contrib.series(strength)
-        truth.update({
-            "form": fam.form, "library_form": fam.library_form, "strength_name": fam.strength,
-            "strength_unit": fam.unit, "strength": float(strength), "shape": shape,
-            "calibration_evaluations": evals,
-            "zero_strength_ratio": (contrib.rms(0.0) / noise_rms
-                                    if fam.code == BACKLASH else 0.0),
-        })
-    window = slice(settings.lead_in, None)
-    c_w = contribution[window]
-    c_rms = float(np.sqrt(np.mean(c_w**2)))
-    raw_energy = float(np.sum(raw[window] ** 2))
-    truth.update({
-        "contribution_rms": c_rms,
-        "contribution_ratio": c_rms / noise_rms,
-        "peak_to_noise": float(np.max(np.abs(c_w))) / noise_rms if c_rms > 0 else 0.0,
-        "window_rms_to_noise": _window_rms_max(c_w, int(round(settings.fs))) / noise_rms,
-        "filter_removed_share": (1.0 - float(np.sum(c_w**2)) / raw_energy
-                                 if raw_energy > 0 else 0.0),
-    })
-    truth["invisible"] = bool(truth["peak_to_noise"] < INVISIBLE_PEAK)
-    if masking and c_rms > 0:
-        jac = _baseline_sensitivities(exc, device, settings)[window]
-        beta, *_ = np.linalg.lstsq(jac, c_w, rcond=None)
-        left = c_w - jac @ beta
-        truth["unabsorbed_to_noise"] = float(np.sqrt(np.mean(left**2))) / noise_rms
-        truth["absorbed_shift"] = dict(zip(["c_m", "F_c", "beta"], (-beta).tolist()))
-
-    # the recording: both sensors' noise, then the study's zero-phase low-pass on both channels
-    y_out = exc.decimate(exc.y_fine)
-    z_out = exc.decimate(acc_fine)
-    base = y_out + settings.noise_m_s2 * rng_base.standard_normal(settings.n)
-    mass = y_out + z_out + settings.noise_m_s2 * rng_mass.standard_normal(settings.n)
-    lp = dict(fs=settings.fs, cutoff_hz=settings.lowpass_hz, order=settings.filter_order)
-    noise_rel = lowpass((mass - y_out - z_out) - (base - y_out), **lp)
-    truth["noise_rms_realised"] = float(np.sqrt(np.mean(noise_rel[window] ** 2)))
-    rec = pd.DataFrame({"time": np.arange(settings.n) / settings.fs,
-                        "base_acc": lowpass(base, **lp), "rel_acc": lowpass(mass - base, **lp)})
+        acc_fine, raw, contribution, effect_truth = _calibrated_effect(
+            fam, effect, seed, settings, exc, device, without, z_fine, ratio * noise_rms,
+            noise_rms)
+        truth.update(effect_truth)
+    truth.update(_how_it_hides(contribution, raw, settings, noise_rms))
+    if masking and truth["contribution_rms"] > 0:
+        truth.update(_unabsorbed(exc, device, settings, contribution, noise_rms))
+    rec, truth["noise_rms_realised"] = _record(exc, acc_fine, settings, rng_base, rng_mass)
     log.info("scenario %s r=%g seed=%d: %s", effect, ratio, seed,
              ", ".join(f"{k}={truth[k]:.4g}" for k in ("contribution_ratio", "peak_to_noise")
                        if k in truth) + (f", {truth['strength_name']}={truth['strength']:.4g}"

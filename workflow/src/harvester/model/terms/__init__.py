@@ -31,9 +31,12 @@ of eq. 1). Kinds of term and the signature of their force law:
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import pkgutil
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
+from types import ModuleType
 
 import numpy as np
 
@@ -41,9 +44,13 @@ from harvester.model.priors import REFERENCE_DEVICE, DeviceScale, Prior, PriorSp
 
 #: Regularising velocity (m/s) for sign-like friction laws: sgn(v) ~ tanh(v / V_EPS).
 V_EPS = 1.0e-3
-#: Largest velocity (m/s) and displacement (m) assumed when bounding stiffness for step control.
+#: Largest velocity (m/s) assumed when bounding stiffness for step control.
 V_BOUND = 1.0
-Z_BOUND = 0.3
+#: Largest displacement per unit of that velocity (s): a motion whose speed stays below v_bound
+#: moves at most v_bound / (2 pi f) at frequency f; 1 / (2 pi 0.5 Hz), the lowest frequency a
+#: record of these devices resolves (below it the spring k holds the mass). 1 m/s: 0.32 m.
+Z_PER_V = 1.0 / (2.0 * np.pi * 0.5)
+Z_BOUND = Z_PER_V * V_BOUND
 
 KINDS = ("screw", "mass", "inertia", "mode", "coupling")
 
@@ -123,7 +130,9 @@ class Term:
     :class:`RateBound`. ``probe``: how the diagnosis sees the term (:class:`Probe`).
     ``refines``: a refinement of one of these terms' laws, meaningless without one of them (a
     Stribeck excess is over a sliding friction): a candidate only where one is in the
-    structure. ``n_states``: internal states the term adds.
+    structure. ``alike``: terms that describe the same physics in another form (a tanh law and
+    Coulomb friction): naming either is naming the effect (:func:`same_physics`). ``n_states``:
+    internal states the term adds.
     """
 
     name: str
@@ -138,6 +147,7 @@ class Term:
     state_rates: Callable | None = None
     masses: Callable | None = None
     refines: tuple[str, ...] = ()
+    alike: tuple[str, ...] = ()
     source: str = field(default="", compare=False)  # the file that defines the term
 
     @property
@@ -218,16 +228,39 @@ def register(t: Term) -> Term:
     return t
 
 
+def _register_module(module: ModuleType, stem: str) -> Term:
+    """Register a term module's ``TERM``, which must be named for the file (``<stem>.py``)."""
+    t = getattr(module, "TERM", None)
+    if not isinstance(t, Term):
+        raise ValueError(f"{module.__file__} defines no TERM (a harvester.model.terms.Term)")
+    if t.name != stem:
+        raise ValueError(f"{module.__file__} defines the term {t.name!r}; the file must be "
+                         f"named for it ({t.name}.py)")
+    return register(t)
+
+
 def _discover() -> None:
+    """Register every module of this package (a new file here is a new term)."""
     for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
-        module = importlib.import_module(f"{__name__}.{info.name}")
-        t = getattr(module, "TERM", None)
-        if not isinstance(t, Term):
-            raise ValueError(f"{module.__file__} defines no TERM (a harvester.model.terms.Term)")
-        if t.name != info.name:
-            raise ValueError(f"{module.__file__} defines the term {t.name!r}; the file must be "
-                             f"named for it ({t.name}.py)")
-        register(t)
+        _register_module(importlib.import_module(f"{__name__}.{info.name}"), info.name)
+
+
+def load_term_file(path: str | Path) -> Term:
+    """Register the term of a file outside this package (``<name>.py`` defining ``TERM``),
+    with the checks the package's own terms pass; returns it. For a term kept beside a
+    project rather than in ``model/terms/`` (``docs/adding-a-term.md``)."""
+    path = Path(path)
+    spec = importlib.util.spec_from_file_location(f"harvester_term_{path.stem}", path)
+    if spec is None or spec.loader is None:
+        raise ValueError(f"{path}: not a Python file")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return _register_module(module, path.stem)
+
+
+def same_physics(a: str, b: str) -> bool:
+    """Whether two terms describe the same physics (equal, or ``alike`` either way)."""
+    return a == b or b in TERMS[a].alike or a in TERMS[b].alike
 
 
 def term(name: str) -> Term:
@@ -244,7 +277,8 @@ def step_rates(terms: tuple[Term, ...], params: dict[str, np.ndarray],
 
     ``params`` maps every parameter of the base and the terms to an array (one value per
     particle); ``v_bound`` (m/s): the largest velocity assumed for velocity-dependent rates
-    (Dahl relaxation, quadratic damping); None: V_BOUND. A caller that knows the motion gives
+    (Dahl relaxation, quadratic damping), and Z_PER_V x it the largest displacement (a cubic
+    spring); None: V_BOUND. A caller that knows the motion gives
     a tighter one. The largest of: damping rate (d force / d velocity) / mass, natural
     frequency sqrt(stiffness / mass) of every spring, contact and mode, and each term's own
     rate. Used only to choose the integrator's sub-step.
@@ -253,7 +287,8 @@ def step_rates(terms: tuple[Term, ...], params: dict[str, np.ndarray],
     for t in terms:
         if t.masses is not None:
             mass, m_osc = t.masses(mass, m_osc, *(params[n] for n in t.parameter_names))
-    motion = Motion(np.maximum(mass, 1e-3), m_osc, V_BOUND if v_bound is None else v_bound)
+    v = V_BOUND if v_bound is None else v_bound
+    motion = Motion(np.maximum(mass, 1e-3), m_osc, v, Z_PER_V * v)
     damp, stiff = np.abs(params["c_m"]).copy(), np.abs(params["k"]).copy()
     rate = np.zeros_like(damp)
     for t in terms:

@@ -39,7 +39,7 @@ TERM = Term(
                 "damping force the motion shows"),
             "half the difference of down- and up-going friction"),
         Parameter("v_asym", "m/s", Prior(
-            "loguniform", 1.0 / 300.0, 3.0, "v",
+            "loguniform", 0.01, 3.0, "v",
             why="its transition velocity over the same decades as a sliding law's"),
             "transition velocity of the direction-dependent part"),
     ),

@@ -27,4 +27,5 @@ TERM = Term(
         "Coulomb friction force"),),
     equation="f = F_coulomb sgn(w), sgn regularised as tanh(w / 1 mm/s)",
     description="Coulomb (dry) friction", force=force, rate_bound=rate_bound,
+    alike=("tanh_friction",),
     probe=Probe("F_coulomb", lambda d: 1.0), source=__file__)

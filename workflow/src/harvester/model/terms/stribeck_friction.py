@@ -45,9 +45,10 @@ TERM = Term(
                 "the motion shows"),
             "excess of breakaway over sliding friction"),
         Parameter("v_stribeck", "m/s", Prior(
-            "loguniform", 0.01, 3.0, "v",
-            why="the Stribeck velocity from 1/100 of the RMS velocity to 3 x it: below, the "
-                "data cannot see the excess; above, it is viscous-like"),
+            "loguniform", 1.0 / 30.0, 3.0, "v",
+            why="the Stribeck velocity from 1/30 of the RMS velocity to 3 x it: below, the "
+                "excess lives within the recording's velocity resolution; above, it is "
+                "viscous-like"),
             "Stribeck velocity"),
         Parameter("delta_stribeck", "-", Prior(
             "normal", 1.5, 0.5, lower=0.5, upper=3.0,

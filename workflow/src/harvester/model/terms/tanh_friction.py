@@ -32,13 +32,15 @@ TERM = Term(
                 "to twice it (friction is part of that force)"),
             "friction force amplitude"),
         Parameter("beta", "s/m", Prior(
-            "loguniform", 1.0 / 3.0, 300.0, "1/v",
+            "loguniform", 1.0 / 3.0, 100.0, "1/v",
             why="the transition velocity 1 / beta from 3 x the RMS velocity (friction almost "
-                "viscous) to 1/300 of it (a sign law at any resolution the data have)"),
+                "viscous) to 1/100 of it: below, a recording's velocity resolution (noise x "
+                "sample time, about 1/100 of the RMS velocity on a shaker record) cannot tell "
+                "it from a sign law, and each decade costs ten times the integrator's steps"),
             "steepness at velocity reversal"),
     ),
     equation="f = F_c tanh(beta w)", description="hyperbolic tangent friction (Table 4)",
-    force=force, rate_bound=rate_bound,
+    force=force, rate_bound=rate_bound, alike=("coulomb_friction",),
     probe=Probe("F_c", lambda d: 1.0,
                 shapes=lambda d: [{"beta": b / d.v} for b in (1.0, 3.0, 10.0, 30.0)]),
     source=__file__)

@@ -1,0 +1,108 @@
+"""Rounds of detect -> rank -> confirm: the diagnosis adds one effect at a time.
+
+Each round detects and locates the mismatch of the current structure (``detect``), ranks the
+library's effects by how much of it each explains (``rank``), samples the best few by TMCMC
+and judges them by evidence (``confirm``), and adopts the best accepted one. It stops when
+nothing is detected, nothing is worth sampling, nothing sampled is accepted, or after
+``settings.rounds`` additions.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from harvester.diagnosis.analysis import Analysis, BaselineStart
+from harvester.diagnosis.baseline import BaselineState, baseline_state
+from harvester.diagnosis.confirm import CandidateResult, ModelFit, confirm, fit_structure
+from harvester.diagnosis.detect import Detection, detect
+from harvester.diagnosis.rank import RankedCandidate, rank, to_confirm
+from harvester.diagnosis.settings import DiagnosisSettings
+from harvester.diagnosis.signatures import candidate_terms, motion_scale
+from harvester.model.priors import DeviceScale
+from harvester.model.structures import ModelStructure
+
+log = logging.getLogger("harvester.diagnosis")
+
+
+@dataclass
+class Round:
+    """One pass of detect -> rank -> confirm on the current structure."""
+
+    structure: str
+    detection: Detection
+    state: BaselineState
+    ranked: list[RankedCandidate]
+    confirmed: list[CandidateResult] = field(default_factory=list)
+    scale: DeviceScale | None = None  # the scales the candidates' priors were read on
+
+    @property
+    def accepted(self) -> CandidateResult | None:
+        acc = [r for r in self.confirmed if r.accepted]
+        return acc[0] if acc else None
+
+
+@dataclass
+class Current:
+    """Where the rounds stand: the structure, its fit (None until sampled), its posterior
+    samples and the priors so far."""
+
+    structure: ModelStructure
+    fit: ModelFit | None
+    samples: np.ndarray
+    priors: dict
+
+
+def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSettings
+               ) -> tuple[list[Round], ModelFit | None, bool, list[str]]:
+    """(rounds, the baseline's fit (sampled here if the start had none and a round needed it),
+    whether a detected mismatch is left unexplained, notes)."""
+    now = Current(analysis.structure, start.fit, start.samples, dict(start.priors))
+    rounds, notes, unexplained = [], [], False
+    baseline_fit = start.fit
+    for r in range(settings.rounds + 1):
+        rnd = detect_round(analysis, start, now, settings, r)
+        rounds.append(rnd)
+        det = rnd.detection
+        if r == settings.rounds or not (det.significant or det.conflict):
+            break
+        chosen = to_confirm(rnd.ranked, det, settings.top)
+        if not chosen:
+            unexplained = unexplained or det.significant
+            if det.significant:
+                notes.append(f"round {r + 1}: mismatch detected (p = {det.p_value:.3g}) but no "
+                             "library effect explains enough of it to be worth sampling")
+            break
+        if now.fit is None:
+            now.fit = fit_structure(start.fit_problem, now.structure, now.priors,
+                                    settings.confirmation())
+            baseline_fit = baseline_fit or now.fit
+        scale = rnd.scale = motion_scale(rnd.state, analysis.window, det.frame.f_high)
+        rnd.confirmed = confirm(now.fit, [c.effect for c in chosen], now.priors,
+                                settings.confirmation(), scale, seed_offset=1000 * (r + 1),
+                                detection=det)
+        best = rnd.accepted
+        if best is None:
+            unexplained = unexplained or det.significant
+            if det.significant:
+                notes.append(f"round {r + 1}: mismatch detected (p = {det.p_value:.3g}); "
+                             "no candidate sampled gained enough evidence")
+            break
+        now = Current(best.fit.structure, best.fit, best.fit.samples,
+                      {**best.fit.priors, **now.priors})
+        unexplained = unexplained and not det.significant
+    return rounds, baseline_fit, unexplained, notes
+
+
+def detect_round(analysis: Analysis, start: BaselineStart, now: Current,
+                 settings: DiagnosisSettings, r: int) -> Round:
+    """Detection, location and ranking of the current structure's mismatch."""
+    problem = analysis.chain(start.detection_problem, start.temper, structure=now.structure)
+    state = baseline_state(problem, now.samples)
+    candidates = candidate_terms(now.structure.terms, settings.candidates)
+    ds = settings.detection()
+    det = detect(state, analysis.window, now.priors, candidates,
+                 replace(ds, seed=ds.seed + r), time=analysis.time)
+    return Round(now.structure.name, det, state, rank(det, state, now.priors))

@@ -1,0 +1,106 @@
+"""The diagnosis's settings: what it spends and where (``DiagnosisSettings``)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+from harvester.diagnosis.confirm import ConfirmSettings
+from harvester.diagnosis.detect import DetectionSettings
+
+
+@dataclass(frozen=True)
+class DiagnosisSettings:
+    """Settings of :func:`diagnose` (defaults: a 40 s recording in minutes on 2 cores).
+
+    particles, chains, seed: TMCMC; rounds: most effects added one after the other; top:
+    candidates sampled per round; bootstrap, artifact_components, alpha, window_s: detection
+    (``DetectionSettings``); evidence_alpha: acceptance
+    (``ConfirmSettings``); unexplained_alpha: a detection that no library effect explains
+    counts as missing physics only below this p-value (an effect confirmed by evidence
+    always does; see ``decide_verdict``); lead_in_s: start of the analysis (the model starts at rest);
+    fit_seconds: most seconds of the recording TMCMC fits (None, the default: the whole window
+    the detection analyses, all but the holdout); holdout_fraction: share of the recording's end kept unseen when no validation
+    record is given; lowpass_hz: cut-off of the zero-phase low-pass the recording went
+    through (None: found from its spectrum, ``spectral.filter_cutoff``); filter_order: its
+    order; candidates: library terms considered (None: all); predictive_samples: posterior
+    samples simulated for the unseen-data comparison; figures: write figures;
+    reference_start: half of each model's initial particles start where other evidence puts
+    them, the baseline's at its MAP and Laplace covariance (``confirm.map_reference``), a
+    candidate's at the nested model's posterior and, for a start shape (a mode's frequency),
+    the detection's scan (``confirm.candidate_reference``); the tempering path changes, not
+    the posterior or the evidence. False: every model from its prior. enlargements: how often
+    a model whose two chains disagree by more than a nat is sampled again with twice the
+    particles.
+    """
+
+    particles: int = 300
+    chains: int = 2
+    seed: int = 0
+    rounds: int = 2
+    top: int = 3
+    bootstrap: int = 400
+    artifact_components: int = 60
+    alpha: float = 0.05
+    evidence_alpha: float = 0.05
+    unexplained_alpha: float = 0.001
+    window_s: float = 1.0
+    lead_in_s: float = 1.0
+    fit_seconds: float | None = None
+    holdout_fraction: float = 0.25
+    lowpass_hz: float | None = None
+    filter_order: int = 8
+    candidates: tuple[str, ...] | None = None
+    predictive_samples: int = 100
+    enlargements: int = 2
+    figures: bool = True
+    reference_start: bool = True
+
+    @classmethod
+    def fast(cls, **overrides) -> "DiagnosisSettings":
+        """Cheaper settings for grids of many recordings only: one round, two candidates,
+        fewer particles and replicates, 10 s fitted (:meth:`trades` says what they give up)."""
+        base = dict(particles=150, rounds=1, top=2, bootstrap=300, artifact_components=30,
+                    fit_seconds=10.0, predictive_samples=40, enlargements=1)
+        return cls(**{**base, **overrides})
+
+    def trades(self) -> list[str]:
+        """What these settings give up against the defaults, one line each (logged and
+        written to diagnosis.json as ``traded_away``); empty for the defaults."""
+        default = DiagnosisSettings()
+        lines = []
+        if self.fit_seconds is not None:
+            lines.append(f"TMCMC fits at most {self.fit_seconds:g} s of the analysed window "
+                         "(default: all of it, as the detection)")
+        for name, what in (("particles", "TMCMC particles per chain"),
+                           ("chains", "TMCMC chains"),
+                           ("rounds", "rounds of effects added in turn"),
+                           ("top", "candidates sampled per round"),
+                           ("bootstrap", "noise replicates of the detection"),
+                           ("artifact_components", "filter-artefact replicates"),
+                           ("predictive_samples", "posterior samples of the unseen-data fit"),
+                           ("enlargements", "re-runs with more particles where chains disagree")):
+            ours, theirs = getattr(self, name), getattr(default, name)
+            if ours < theirs:
+                lines.append(f"{ours} {what} (default {theirs})")
+        return lines
+
+    @classmethod
+    def from_config(cls, cfg: Mapping) -> "DiagnosisSettings":
+        """From a config section (keys as the fields; ``fast: true`` starts from ``fast()``)."""
+        unknown = sorted(set(cfg) - set(cls.__dataclass_fields__) - {"fast"})
+        if unknown:
+            raise ValueError(f"diagnosis settings: unknown key(s) {unknown}")
+        values = {k: (tuple(v) if k == "candidates" and v is not None else v)
+                  for k, v in cfg.items() if k != "fast"}
+        return cls.fast(**values) if cfg.get("fast") else cls(**values)
+
+    def detection(self) -> DetectionSettings:
+        return DetectionSettings(bootstrap=self.bootstrap, alpha=self.alpha,
+                                 window_s=self.window_s, seed=self.seed,
+                                 artifact_components=self.artifact_components)
+
+    def confirmation(self) -> ConfirmSettings:
+        return ConfirmSettings(particles=self.particles, chains=self.chains, seed=self.seed,
+                               enlargements=self.enlargements, alpha=self.evidence_alpha,
+                               reference=self.reference_start)

@@ -1,0 +1,74 @@
+"""The grid's two truth generators behind one call: a scenario's recording and its truth in
+the form the scoring reads.
+
+``library``: :mod:`harvester.synthetic.scenarios`, the virtual rig with one of the library's
+own effects (its shapes and priors). ``literature``: :mod:`harvester.synthetic.literature`,
+written from the published forms without reading the library (LuGre, Bouc-Wen, Hertz and
+Hunt-Crossley contact, Karnopp, a flexible mount, ...), a new device per seed, a multisine
+excitation and an anti-aliased DAQ. Only the second says whether the diagnosis generalises.
+
+Truth keys the scoring reads (:func:`harvester.grid.scoring.score`): ``effect`` (scenario
+name), ``ratio``, ``seed``, ``baseline``, ``known`` (M, m, k), ``settings.lead_in_s``,
+``contribution_ratio``, ``unabsorbed_to_noise``, ``peak_to_noise``, and for the literature
+generator ``correct_names`` (the library terms that name its mechanism).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+#: The generators a grid may name (config ``detection.grids.<grid>.generator``).
+GENERATORS = ("library", "literature")
+#: The literature generator's effect-free scenario.
+LITERATURE_NONE = "none"
+
+
+def make_scenario_files(generator: str, effect: str, ratio: float, seed: int,
+                        settings: Mapping[str, Any], rig_cfg: Mapping[str, Any],
+                        preprocess: Mapping[str, Any], csv_path, truth_path) -> dict:
+    """Write one scenario's recording (converted CSV) and truth (JSON); return the truth."""
+    if generator == "library":
+        return _library(effect, ratio, seed, settings, rig_cfg, preprocess, csv_path,
+                        truth_path)
+    if generator == "literature":
+        return _literature(effect, ratio, seed, settings, csv_path, truth_path)
+    raise ValueError(f"detection generator {generator!r}: expected one of {GENERATORS}")
+
+
+def _library(effect, ratio, seed, settings, rig_cfg, preprocess, csv_path, truth_path):
+    from harvester.synthetic.scenarios import ScenarioSettings, make_scenario, write_scenario
+
+    chosen = ScenarioSettings.from_config({"rig": rig_cfg, "preprocess": preprocess},
+                                          **settings)
+    scenario = make_scenario(effect, ratio, seed, chosen, rig_cfg=rig_cfg)
+    write_scenario(scenario, csv_path, truth_path)
+    return scenario.truth
+
+
+def _literature(effect, ratio, seed, settings, csv_path, truth_path):
+    from harvester.data.daq import write_recording
+    from harvester.data.fileio import write_json
+    from harvester.synthetic.literature import LEAD_IN_S, generate
+
+    effect_free = effect == LITERATURE_NONE
+    made = generate(effect, seed + int(settings.get("seed", 0)),
+                    ratio=0.0 if effect_free else ratio,
+                    duration_s=float(settings["duration_s"]))
+    lit = made.truth
+    truth = {
+        "effect": effect, "ratio": 0.0 if effect_free else float(ratio), "seed": int(seed),
+        "baseline": "tanh", "known": dict(made.sidecar), "generator": "literature",
+        "settings": {"lead_in_s": LEAD_IN_S, "duration_s": float(settings["duration_s"])},
+        "contribution_ratio": float(lit.get("ratio_achieved", 0.0)),
+        "unabsorbed_to_noise": float(lit.get("unabsorbed_to_noise", 0.0)),
+        "peak_to_noise": float(lit.get("peak_to_noise", 0.0)),
+        "noise_rms": float(lit.get("noise_rms_rel_acc", float("nan"))),
+        "invisible": False,
+        "correct_names": list(lit.get("correct_names") or []),
+        "related_names": list(lit.get("related_names") or []),
+        "literature": lit,
+    }
+    write_recording(made.recording, csv_path)
+    write_json(truth, truth_path)
+    return truth
