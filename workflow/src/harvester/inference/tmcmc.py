@@ -268,13 +268,15 @@ def _em(x: np.ndarray, w: np.ndarray, k: int, rng: np.random.Generator, iteratio
         ) -> tuple[GaussianMixture, float]:
     """EM for a k-component mixture; returns it and the weighted mean log-likelihood."""
     n, d = x.shape
-    scale = np.mean(np.diag(np.atleast_2d(np.cov(x.T, aweights=w))))
+    # jitter per coordinate: parameters may differ by decades in scale (a stiffness in N/m^3
+    # beside a noise sd in m/s^2), and one shared jitter would swamp the small ones
+    floor = 1e-9 * _variance_floor(weighted_covariance(x, w))
     means = x[rng.choice(n, size=k, replace=False, p=w)]
     covs = np.array([weighted_covariance(x, w) for _ in range(k)])
     pis = np.full(k, 1.0 / k)
     loglike = -np.inf
     for _ in range(iterations):
-        chols = np.array([_cholesky_with_jitter(c + 1e-9 * scale * np.eye(d)) for c in covs])
+        chols = np.array([_cholesky_with_jitter(c + floor) for c in covs])
         comp = np.array([GaussianMixture(np.ones(1), means[j:j + 1], chols[j:j + 1])
                          .log_density(x) + np.log(pis[j]) for j in range(k)])
         total = logsumexp(comp, axis=0)
@@ -289,7 +291,7 @@ def _em(x: np.ndarray, w: np.ndarray, k: int, rng: np.random.Generator, iteratio
             loglike = new
             break
         loglike = new
-    chols = np.array([_cholesky_with_jitter(c + 1e-9 * scale * np.eye(d)) for c in covs])
+    chols = np.array([_cholesky_with_jitter(c + floor) for c in covs])
     return GaussianMixture(pis, means, chols), loglike
 
 
@@ -301,15 +303,23 @@ def weighted_covariance(particles: np.ndarray, weights: np.ndarray) -> np.ndarra
     return np.atleast_2d((centred * weights[:, None]).T @ centred)
 
 
+def _variance_floor(cov: np.ndarray) -> np.ndarray:
+    """Diagonal matrix of each coordinate's variance, at least 1e-12 x their mean (a
+    coordinate the population no longer spreads in keeps a jitter of its own)."""
+    var = np.diag(cov)
+    return np.diag(np.maximum(var, 1e-12 * max(float(np.mean(var)), 1e-300)))
+
+
 def _cholesky_with_jitter(cov: np.ndarray) -> np.ndarray:
-    """Cholesky factor, adding a growing diagonal jitter if the covariance is degenerate."""
-    scale = max(float(np.mean(np.diag(cov))), 1e-12)
+    """Cholesky factor, adding a growing diagonal jitter (relative to each coordinate's
+    variance) if the covariance is degenerate."""
+    diag = _variance_floor(cov)
     jitter = 0.0
     for _ in range(12):
         try:
-            return np.linalg.cholesky(cov + jitter * np.eye(len(cov)))
+            return np.linalg.cholesky(cov + jitter * diag)
         except np.linalg.LinAlgError:
-            jitter = scale * 1e-10 if jitter == 0.0 else jitter * 10.0
+            jitter = 1e-10 if jitter == 0.0 else jitter * 10.0
     raise TMCMCError(f"the proposal covariance is not positive definite:\n{cov}")
 
 
