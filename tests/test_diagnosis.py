@@ -281,3 +281,20 @@ def test_separating_experiments_are_the_recordings_own_scaled_and_a_sweep():
     sweep = exps[2].base_acc
     assert sweep.size == u.size
     assert np.sqrt(np.mean(sweep[256:-256] ** 2)) == pytest.approx(np.std(u), rel=0.05)
+
+
+def test_a_posterior_is_piled_against_a_bound_only_when_the_bound_cuts_it():
+    from harvester.diagnosis.detect import at_prior_edge
+    from harvester.inference.priors import PriorSpec
+
+    rng = np.random.default_rng(0)
+    wide = PriorSpec("k_cubic", 0.0, 4e7, "N/m^3", lower=-2.85e6)
+    # a narrow posterior far inside the prior (165 of its own sds above the bound), although
+    # near the bound on the prior's scale: not piled
+    assert at_prior_edge(wide, 9.9e5 + 2.3e4 * rng.standard_normal(400)) is None
+    # a posterior squeezed against the bound: piled
+    assert at_prior_edge(wide, -2.85e6 + np.abs(2e5 * rng.standard_normal(400))) == "lower"
+    log_uniform = PriorSpec.log_uniform("mass_mode", 0.01, 10.0, "kg")
+    assert at_prior_edge(log_uniform, 0.01 * np.exp(np.abs(0.05 * rng.standard_normal(400)))) \
+        == "lower"
+    assert at_prior_edge(log_uniform, np.exp(0.3 * rng.standard_normal(400))) is None

@@ -199,6 +199,10 @@ EDGE_MASS = 0.5
 EDGE_SHARE = 0.05
 
 
+#: The bound cuts the posterior when it lies within this many posterior sds of its mean.
+EDGE_SDS = 3.0
+
+
 def at_prior_edge(spec: PriorSpec, x: np.ndarray) -> str | None:
     """'lower' or 'upper' where the posterior samples x pile against that bound of a prior
     with a finite range (a finding to report: the prior cut off what the data wanted), else
@@ -209,8 +213,13 @@ def at_prior_edge(spec: PriorSpec, x: np.ndarray) -> str | None:
         return None
     u = spec.to_coordinate(np.asarray(x, dtype=float))
     width = (high - low) if np.isfinite(low) and np.isfinite(high) else 6.0 * spec.scale
+    spread = max(float(np.std(u)), 1e-300)
     for side, bound, near in (("lower", low, u - low), ("upper", high, high - u)):
-        if np.isfinite(bound) and np.mean(near < EDGE_SHARE * width) >= EDGE_MASS:
+        # most samples near the bound on the prior's scale, and the bound within a few of the
+        # posterior's own sds (it cuts the posterior: a narrow posterior far inside a broad
+        # prior is not piled against the bound however near it looks on the prior's scale)
+        if np.isfinite(bound) and np.mean(near < EDGE_SHARE * width) >= EDGE_MASS \
+                and np.mean(near) < EDGE_SDS * spread:
             return side
     return None
 
