@@ -298,3 +298,14 @@ def test_a_posterior_is_piled_against_a_bound_only_when_the_bound_cuts_it():
     assert at_prior_edge(log_uniform, 0.01 * np.exp(np.abs(0.05 * rng.standard_normal(400)))) \
         == "lower"
     assert at_prior_edge(log_uniform, np.exp(0.3 * rng.standard_normal(400))) is None
+
+
+def test_chains_are_enlarged_only_where_a_decision_lies_within_their_range():
+    from harvester.diagnosis.confirm import _straddles
+
+    # acceptance at baseline + 3; a tie boundary at best - 3 and best + 3
+    decisions = (103.0, 497.0, 503.0)
+    assert _straddles(np.array([101.5, 102.9]), decisions, 1.0)       # near acceptance
+    assert not _straddles(np.array([60.0, 61.2]), decisions, 1.0)     # far below: rejected
+    assert not _straddles(np.array([300.0, 301.5]), decisions, 1.0)   # accepted, far behind
+    assert _straddles(np.array([495.0, 496.5]), decisions, 1.0)       # a possible tie

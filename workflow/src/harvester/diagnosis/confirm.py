@@ -397,10 +397,13 @@ def describe_start(ref: Reference) -> str:
 
 def fit_structure(problem: ChainProblem, structure: ModelStructure,
                   priors: Mapping[str, PriorSpec], settings: ConfirmSettings,
-                  seed_offset: int = 0, reference: Reference | None = None) -> ModelFit:
+                  seed_offset: int = 0, reference: Reference | None = None,
+                  decisions: tuple[float, ...] | None = None) -> ModelFit:
     """TMCMC of ``structure`` on the data, window, chain and tempering of ``problem``
     (from ``reference`` instead of the prior where given); sampled again with twice the
-    particles while its chains disagree by more than ``settings.agreement_nats``."""
+    particles while its chains disagree by more than ``settings.agreement_nats``, unless
+    ``decisions`` (log evidences where the diagnosis's decision changes) are all outside the
+    chains' range widened by that much: then no precision bought would change anything."""
     p = chain_problem(problem, problem.temper, problem.lowpass_hz, problem.filter_order,
                       structure=structure)
     used = priors_for(p, priors)
@@ -411,6 +414,10 @@ def fit_structure(problem: ChainProblem, structure: ModelStructure,
         ev = log_evidence(idata)
         spread = float(np.ptp(ev)) if len(ev) > 1 else 0.0
         if spread <= settings.agreement_nats or attempt == settings.enlargements:
+            break
+        if decisions is not None and not _straddles(ev, decisions, settings.agreement_nats):
+            log.info("%s: the chains differ by %.2f nats, but no decision lies within their "
+                     "range: not sampled again", structure.name, spread)
             break
         log.warning("%s: the chains' log evidences differ by %.2f nats (more than %.1f) with "
                     "%d particles; sampled again with %d", structure.name, spread,
@@ -450,9 +457,16 @@ def bridge_evidence(problem: ChainProblem, priors: Mapping[str, PriorSpec],
         return None
 
 
+def _straddles(ev: np.ndarray, decisions: tuple[float, ...], margin: float) -> bool:
+    """Whether any decision point lies within the chains' log evidences widened by margin."""
+    low, high = float(np.min(ev)) - margin, float(np.max(ev)) + margin
+    return any(low <= d <= high for d in decisions)
+
+
 def candidate_fit(baseline: ModelFit, effect: str, priors: Mapping[str, PriorSpec],
                   settings: ConfirmSettings, scale: DeviceScale,
-                  detection: Detection | None = None, seed_offset: int = 0) -> ModelFit:
+                  detection: Detection | None = None, seed_offset: int = 0,
+                  decisions: tuple[float, ...] | None = None) -> ModelFit:
     """The baseline with one more term, sampled by TMCMC: its priors (the candidate's
     scaled to this device, ``priors`` winning), its particles (:func:`candidate_particles`)
     and its start (:func:`candidate_reference`, sampled again from the prior if that
@@ -466,7 +480,7 @@ def candidate_fit(baseline: ModelFit, effect: str, priors: Mapping[str, PriorSpe
     log.info("%s: %d particles per chain%s", structure.name, run.particles,
              "" if ref is None else "; half the particles start from " + describe_start(ref))
     fit = fit_structure(baseline.problem, structure, specs, run, seed_offset=seed_offset,
-                        reference=ref)
+                        reference=ref, decisions=decisions)
     if ref is not None and collapsed(fit):
         log.warning("%s: the population started from the reference collapsed; sampled "
                     "again from the prior", structure.name)
@@ -486,11 +500,24 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
         log.info("confirming %s (%d of %d)", baseline.structure.with_term(effect).name, i + 1,
                  len(effects))
         fit = candidate_fit(baseline, effect, priors, settings, scale, detection,
-                            seed_offset + 101 * (i + 1))
+                            seed_offset + 101 * (i + 1), decisions(baseline, results, settings))
         results.append(judge(effect, fit, baseline, settings))
     results.sort(key=lambda r: -r.delta_log_evidence)
     mark_ties(results, settings)
     return results
+
+
+def decisions(baseline: ModelFit, results: list[CandidateResult], settings: ConfirmSettings
+              ) -> tuple[float, ...]:
+    """Log evidences at which a candidate's fate changes: acceptance over the baseline, and
+    a tie with (or a lead over) the best accepted so far (``mark_ties``), each by
+    log(1/alpha)."""
+    step = float(np.log(1.0 / settings.alpha))
+    points = [baseline.log_evidence + step]
+    accepted = [r.fit.log_evidence for r in results if r.accepted]
+    if accepted:
+        points += [max(accepted) - step, max(accepted) + step]
+    return tuple(points)
 
 
 def judge(effect: str, fit: ModelFit, baseline: ModelFit, settings: ConfirmSettings
