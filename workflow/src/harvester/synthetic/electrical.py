@@ -281,6 +281,15 @@ def _integrate_loaded(drive, dt, nsub, z0, v0, dwell0, F_s, tau, v_stick, prm, c
             vi, is_stuck, dwell = 0.0, True, 0.0
         z[i + 1], v[i + 1], stuck[i + 1] = zi, vi, is_stuck
         ia[i + 1], ib[i + 1] = ii, ji
+    a, f, fe = _outputs(drive, dt, z, v, ia, ib, jump, stuck, prm, coupled)
+    return z, v, ia, ib, a, f, fe, stuck
+
+
+@nb.njit(cache=True)
+def _outputs(drive, dt, z, v, ia, ib, jump, stuck, prm, coupled):
+    """z'' (the velocity jump over dt where the mass sticks), friction f and F_e per sample."""
+    n = drive.size
+    k, F_s0 = prm[_K], prm[_FS0]
     a = np.empty(n)
     f = np.empty(n)
     fe = np.empty(n)
@@ -292,7 +301,7 @@ def _integrate_loaded(drive, dt, nsub, z0, v0, dwell0, F_s, tau, v_stick, prm, c
         else:
             f[i] = _friction(v[i], hold, prm[_FC], prm[_BETA], F_s0)
             a[i] = (hold - prm[_C] * v[i] - f[i]) / prm[_M]
-    return z, v, ia, ib, a, f, fe, stuck
+    return a, f, fe
 
 
 # --------------------------------------------------------------------------- motion
