@@ -16,6 +16,7 @@ from harvester.electrical.priors import MECHANICAL, generator_priors, noise_prio
 from harvester.electrical.problem import STRUCTURES, ElectricalProblem
 from harvester.inference.batched import loglike_potential
 from harvester.inference.identify import TMCMCSettings
+from harvester.inference.posterior import set_known
 from harvester.inference.pymc_model import prior_variable
 from harvester.inference.tmcmc import run_tmcmc
 
@@ -41,16 +42,10 @@ def identify(problem: ElectricalProblem, sigma_prior: Mapping,
     log.info("TMCMC for %s: %s; %d particles x %d chains; records %s", problem.structure,
              ", ".join(problem.parameter_names), settings.particles, settings.chains,
              ", ".join(r.name for r in problem.records))
-    idata = run_tmcmc(model, draws=settings.particles, chains=settings.chains,
-                      seed=settings.seed, proposal_scale=settings.proposal_scale,
-                      target_cov=settings.target_cov, mcmc_steps=settings.mcmc_steps,
-                      max_mcmc_steps=settings.max_mcmc_steps,
-                      correlation_threshold=settings.correlation_threshold,
-                      target_accept=settings.target_accept)
+    idata = run_tmcmc(model, **settings.run_arguments())
     idata.posterior.attrs["structure"] = problem.structure
     idata.posterior.attrs["records"] = ",".join(r.name for r in problem.records)
-    idata.posterior.attrs["known"] = ",".join(f"{k}={v!r}" for k, v in
-                                              problem.mechanical.known.items())
+    set_known(idata, problem.mechanical.known)
     return idata
 
 

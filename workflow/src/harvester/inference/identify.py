@@ -11,6 +11,7 @@ import numpy as np
 import pandas as pd
 
 from harvester.inference.likelihood import DAQ_OVERSAMPLE, Problem
+from harvester.inference.posterior import parameter_names, samples, set_known
 from harvester.model.terms import BASE_PARAMETERS
 from harvester.inference.priors import PriorSpec
 from harvester.data.recording import input_output
@@ -38,6 +39,14 @@ class TMCMCSettings:
     @classmethod
     def from_config(cls, cfg: Mapping) -> "TMCMCSettings":
         return cls(**{k: cfg[k] for k in cls.__dataclass_fields__ if k in cfg})
+
+    def run_arguments(self) -> dict:
+        """These settings as the keyword arguments of ``tmcmc.run_tmcmc``."""
+        return dict(draws=self.particles, chains=self.chains, seed=self.seed,
+                    proposal_scale=self.proposal_scale, target_cov=self.target_cov,
+                    mcmc_steps=self.mcmc_steps, max_mcmc_steps=self.max_mcmc_steps,
+                    correlation_threshold=self.correlation_threshold,
+                    target_accept=self.target_accept)
 
 
 def free_base_parameters(model: ModelStructure, known: Mapping[str, float],
@@ -108,16 +117,11 @@ def identify(problem: Problem, priors: Mapping[str, PriorSpec],
     log.info("TMCMC for %s: parameters %s, %d particles x %d chains, %d data points",
              problem.structure.name, ", ".join(problem.parameter_names), settings.particles,
              settings.chains, problem.n_data)
-    idata = run_tmcmc(model, draws=settings.particles, chains=settings.chains, seed=settings.seed,
-                      proposal_scale=settings.proposal_scale, target_cov=settings.target_cov,
-                      mcmc_steps=settings.mcmc_steps, max_mcmc_steps=settings.max_mcmc_steps,
-                      correlation_threshold=settings.correlation_threshold,
-                      target_accept=settings.target_accept,
-                      reference=reference)
+    idata = run_tmcmc(model, reference=reference, **settings.run_arguments())
     idata.posterior.attrs["parameter_names"] = ",".join(problem.parameter_names)
     idata.posterior.attrs["model"] = problem.structure.name
     idata.posterior.attrs["terms"] = ",".join(problem.structure.terms)
-    idata.posterior.attrs["known"] = ",".join(f"{k}={v!r}" for k, v in problem.known.items())
+    set_known(idata, problem.known)
     if problem.output_filter is not None:
         idata.posterior.attrs["output_filter"] = list(problem.output_filter)
     idata.posterior.attrs["free_base"] = ",".join(problem.structure.free_base)
@@ -128,5 +132,4 @@ def identify(problem: Problem, priors: Mapping[str, PriorSpec],
 
 def posterior_theta(idata: az.InferenceData) -> np.ndarray:
     """Posterior rows theta = (free parameters..., sigma), chains pooled."""
-    from harvester.inference.posterior import parameter_names, samples
     return samples(idata, parameter_names(idata))

@@ -17,6 +17,18 @@ def samples(idata: az.InferenceData, names: list[str] | tuple[str, ...]) -> np.n
     return np.column_stack([post[n].values.reshape(-1) for n in names])
 
 
+def set_known(idata: az.InferenceData, known: dict[str, float]) -> None:
+    """Store the values a posterior was conditioned on (M, m, k, ...) with it: the
+    ``known`` attribute, "name=value,..." (netCDF attributes hold no mappings)."""
+    idata.posterior.attrs["known"] = ",".join(f"{k}={float(v)!r}" for k, v in known.items())
+
+
+def known_values(idata: az.InferenceData) -> dict[str, float]:
+    """The values stored by :func:`set_known` (empty when there are none)."""
+    items = [v for v in str(idata.posterior.attrs.get("known") or "").split(",") if v]
+    return {name: float(value) for name, _, value in (i.partition("=") for i in items)}
+
+
 def parameter_names(idata: az.InferenceData) -> list[str]:
     """Identified parameters in the order stored (physical parameters, sigma last)."""
     names = list(idata.posterior.attrs.get("parameter_names", "").split(",")) \

@@ -23,6 +23,7 @@ from harvester.data.recording import UNITS, recording_kinds
 from harvester.data.signals import uniform_step
 from harvester.inference.identify import posterior_theta
 from harvester.inference.likelihood import DAQ_OVERSAMPLE, Problem
+from harvester.inference.posterior import known_values
 from harvester.inference.predictive import (NOMINAL_OUTSIDE, PredictiveBand, mlpd, nrmse,
                                             outside_fraction, posterior_predictive, thin)
 from harvester.inference.recording_fit import END_EFFECTS_S
@@ -42,10 +43,7 @@ def posterior_structure(idata: az.InferenceData, source: str) -> tuple[ModelStru
     if "model" not in attrs or "free_base" not in attrs:
         raise DataError(source, "not a posterior written by harvester identify (no 'model' and "
                         "'free_base' attributes)")
-    known = {}
-    for item in _attr_list(attrs.get("known")):
-        name, _, value = item.partition("=")
-        known[name] = float(value)
+    known = known_values(idata)
     terms = tuple(_attr_list(attrs.get("terms")))
     return ModelStructure(str(attrs["model"]), terms, tuple(_attr_list(attrs["free_base"]))), \
         known
