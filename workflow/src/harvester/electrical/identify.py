@@ -16,7 +16,7 @@ from harvester.electrical.priors import MECHANICAL, generator_priors, noise_prio
 from harvester.electrical.problem import STRUCTURES, ElectricalProblem
 from harvester.inference.batched import loglike_potential
 from harvester.inference.identify import TMCMCSettings
-from harvester.inference.posterior import set_known
+from harvester.inference.posterior import pooled_log_evidence, set_known
 from harvester.inference.pymc_model import prior_variable
 from harvester.inference.tmcmc import run_tmcmc
 
@@ -67,7 +67,7 @@ def evidence_summary(idata: az.InferenceData) -> dict:
     per_chain = np.asarray(stats["log_evidence"].values, dtype=float)
     se = np.asarray(stats["log_evidence_se"].values, dtype=float) \
         if "log_evidence_se" in stats else np.full(per_chain.size, np.nan)
-    pooled = float(logsumexp(per_chain) - np.log(per_chain.size))
+    pooled = pooled_log_evidence(per_chain)
     spread = float(np.std(per_chain, ddof=1) / np.sqrt(per_chain.size)) \
         if per_chain.size > 1 else float("nan")
     within = float(np.sqrt(np.sum(se ** 2)) / per_chain.size)
