@@ -21,8 +21,9 @@ study: $(STAMP)
 emps: $(STAMP)
 	$(BIN)/snakemake --cores $(CORES) emps_all
 
+# One worker per core; a file's tests stay on one worker (they share module fixtures).
 test: $(STAMP)
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n $(CORES) --dist loadfile
 
 test-slow: $(STAMP)
 	$(BIN)/python -m pytest -m slow

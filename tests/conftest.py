@@ -15,6 +15,16 @@ ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = Path(sys.executable).with_name("snakemake")
 
 
+#: Test files whose module fixtures run a study (minutes): collected first, so that with one
+#: worker per core (``make test``: pytest-xdist, ``--dist loadfile``) they start at once.
+LONG_FILES = ("test_rules.py",)
+
+
+def pytest_collection_modifyitems(items) -> None:
+    """Put the tests of ``LONG_FILES`` first (a stable sort keeps every file's order)."""
+    items.sort(key=lambda item: item.path.name not in LONG_FILES)
+
+
 def small_config() -> dict:
     """The study's config with short records and a small sampler, for rule-level tests."""
     cfg = copy.deepcopy(yaml.safe_load((ROOT / "config/config.yaml").read_text()))

@@ -10,8 +10,9 @@ import pytest
 import yaml
 
 from harvester.data.errors import DataError
-from harvester.data.signals import (CHANNELS, filter_recording, filter_response_db, frf_h1, lowpass,
-                               psd, uniform_step)
+from harvester.data.signals import (CHANNELS, butterworth_sos, filter_recording,
+                               filter_response_db, frf_h1, lowpass, psd, settling_samples,
+                               uniform_step)
 
 CONFIG = yaml.safe_load((Path(__file__).parents[1] / "config" / "config.yaml").read_text())
 FS = float(CONFIG["rig"]["daq"]["sampling_rate_hz"])
@@ -179,3 +180,17 @@ def test_a_dropped_sample_is_named_by_row() -> None:
     t = np.delete(np.arange(2000) / 256.0, 700)
     with pytest.raises(DataError, match="row 702"):
         uniform_step(t, "x.csv")
+
+
+def test_a_zero_phase_filter_does_not_see_a_record_end_past_its_settling_samples():
+    """What the electrical likelihood relies on: the record may stop settling_samples after
+    the last sample it compares, and the filtered values there do not change (to 1e-10)."""
+    sos = butterworth_sos(FS, CUTOFF, ORDER)
+    n = settling_samples(sos)
+    assert 100 < n < 2000
+    x = np.random.default_rng(5).standard_normal(4000)
+    whole = lowpass(x, FS, CUTOFF, ORDER)
+    cut = lowpass(x[: 1500 + n], FS, CUTOFF, ORDER)
+    assert np.max(np.abs(cut[:1500] - whole[:1500])) < 1e-10 * np.std(whole)
+    early = lowpass(x[: 1500 + n // 4], FS, CUTOFF, ORDER)
+    assert np.max(np.abs(early[:1500] - whole[:1500])) > 1e-6 * np.std(whole)

@@ -1,5 +1,6 @@
 """The forward model against a high-accuracy reference, and each physics term in its limits."""
 
+import numba
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -7,7 +8,7 @@ from scipy.signal import butter, sosfilt, sosfiltfilt
 
 from harvester.model.structures import Layout
 from harvester.model.terms import TERMS
-from harvester.model.simulate import simulate
+from harvester.model.simulate import BLOCK, Blocks, simulate
 
 FS = 256.0
 DT = 1.0 / FS
@@ -58,6 +59,31 @@ def test_batched_equals_one_at_a_time(base_acc):
     batch = simulate(lay, P, base_acc, DT).rel_acc
     for i in range(7):
         np.testing.assert_array_equal(batch[i], simulate(lay, P[i], base_acc, DT).rel_acc[0])
+
+
+@pytest.mark.parametrize("n", [3, 40, 150, 300, 1000])
+def test_blocks_give_each_thread_an_equal_share(n):
+    blocks = Blocks.of(np.r_[np.full(n, 4), np.full(n // 3, 8)], parts=2)
+    sizes = blocks.stops - blocks.starts
+    assert sizes.sum() == n + n // 3 and sizes.max() <= BLOCK
+    loads = np.zeros(2)
+    for work in sizes * blocks.n_sub:  # the pool's order: heaviest first, to the idlest thread
+        loads[np.argmin(loads)] += work
+    assert n < 40 or loads.max() <= 1.1 * loads.mean()  # 64 + 64 + 22 of 150 would be 1.15
+
+
+def test_the_threads_and_blocks_do_not_change_the_result(base_acc):
+    rng = np.random.default_rng(4)
+    P = np.tile(BASE + [10.0, 100.0], (150, 1))
+    P[:, 4], P[:, 5] = rng.uniform(0, 30, 150), rng.uniform(0, 500, 150)
+    lay = Layout.of(["tanh_friction"])
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = simulate(lay, P, base_acc, DT).rel_acc
+    finally:
+        numba.set_num_threads(before)
+    np.testing.assert_array_equal(one, simulate(lay, P, base_acc, DT).rel_acc)
 
 
 TERM_PARAMS = {

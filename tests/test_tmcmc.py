@@ -25,6 +25,8 @@ from harvester.inference.tmcmc import (
     TMCMC,
     TMCMCError,
     compile_population_logp,
+    fit_gaussian_mixture,
+    weighted_covariance,
     log_evidence,
     next_beta,
     run_tmcmc,
@@ -401,6 +403,37 @@ def test_reference_densities_are_normalised_and_draws_follow_them():
         _reference(centres=(0.2,), weights=(1.0,))
     with pytest.raises(ValueError, match="distinct"):
         _reference(gaussian=GaussianFactor(("x",), (5.0,), ((1.0,),), (0.5,)))
+
+
+def test_a_particle_of_weight_zero_does_not_spoil_the_proposal():
+    """A particle with zero likelihood may have a coordinate outside the transformed space
+    (inf): with weight zero it must not make the covariance or the mixture NaN."""
+    x = np.random.default_rng(0).standard_normal((200, 3))
+    w = np.random.default_rng(1).random(200)
+    x[7], w[7] = (0.0, np.inf, -np.inf), 0.0
+    np.testing.assert_allclose(weighted_covariance(x, w),
+                               weighted_covariance(x[w > 0], w[w > 0]), rtol=1e-12)
+    mix = fit_gaussian_mixture(x, w, 3, np.random.default_rng(2))
+    assert np.isfinite(mix.means).all() and np.isfinite(mix.chols).all()
+
+
+def test_reference_factors_stay_inside_an_upper_bound_and_are_normalised_there():
+    """A prior with an upper bound (a log-uniform frequency): the factors' draws stay below it
+    (above it PyMC's interval transform has no value) and their densities integrate to 1
+    below it (mass above it would bias the evidence low)."""
+    scan = ScanFactor("x", (2.0, 4.0, 6.0), (0.4, 0.4, 0.4), (1.0, 1.0, 1.0), 0.5, 6.5)
+    assert _quad(lambda v: np.exp(scan.log_density(v)), 0.5, 6.5, [2.0, 4.0, 6.0]) == \
+        pytest.approx(1.0, abs=1e-6)
+    draws = scan.draw(np.random.default_rng(3), 20_000)[:, 0]
+    assert draws.max() < 6.5 and np.isneginf(scan.log_density(np.array([6.5, 7.0]))).all()
+    expected = _quad(lambda v: np.exp(scan.log_density(v)), 5.0, 6.5)
+    assert np.mean(draws > 5.0) == pytest.approx(expected, abs=0.015)
+    g = GaussianFactor(("m",), (0.9,), ((0.04,),), (0.0,), uppers=(1.0,))
+    assert _quad(lambda v: np.exp(g.log_density(v[:, None])), 0.0, 1.0) == \
+        pytest.approx(1.0, abs=2e-3)
+    assert g.draw(np.random.default_rng(4), 1000).max() < 1.0
+    with pytest.raises(ValueError, match="upper bound"):
+        ScanFactor("x", (20.0,), (0.1,), (1.0,), 0.5, 6.5)
 
 
 def _peak_loglike(theta: np.ndarray) -> np.ndarray:

@@ -41,6 +41,14 @@ def butterworth_sos(fs: float, cutoff_hz: float, order: int) -> NDArray[np.float
     return signal.butter(order, cutoff_hz, btype="low", fs=fs, output="sos")
 
 
+def settling_samples(sos: NDArray[np.float64], tol: float = 1e-12) -> int:
+    """Samples after which the filter's impulse response has fallen below ``tol`` of its
+    start: ln(tol) / ln(r), r the largest pole radius. A zero-phase filter's values this far
+    from a record's end do not depend (to ``tol``) on where the record ends."""
+    radius = max(np.max(np.abs(np.roots(section[3:]))) for section in np.atleast_2d(sos))
+    return int(np.ceil(np.log(tol) / np.log(radius)))
+
+
 def lowpass(x: ArrayLike, fs: float, cutoff_hz: float, order: int) -> NDArray[np.float64]:
     """Zero-phase low-pass of ``x`` (forward-backward Butterworth, ``sosfiltfilt``).
 

@@ -74,8 +74,8 @@ BRIDGE_MIN_SE = 0.1
 
 
 @dataclass(frozen=True)
-class ConfirmSettings:
-    """TMCMC and acceptance settings.
+class ConfirmSettings(TMCMCSettings):
+    """TMCMC settings (``TMCMCSettings``, with the defaults below) and acceptance settings.
 
     proposal_scale 0.8 (not Ching & Chen's 0.2): with 0.2 the Metropolis moves accept 85 %
     and barely move, and the log evidence of the tanh model scatters by +-6 nats between
@@ -99,12 +99,8 @@ class ConfirmSettings:
 
     particles: int = 300
     chains: int = 2
-    seed: int = 0
     proposal_scale: float = 0.8
-    target_cov: float = 1.0
     mcmc_steps: int = 3
-    max_mcmc_steps: int | None = 30
-    correlation_threshold: float = 0.1
     agreement_nats: float = 1.0
     enlargements: int = 2
     alpha: float = 0.05
@@ -113,11 +109,9 @@ class ConfirmSettings:
     reference: bool = True
 
     def tmcmc(self, offset: int = 0) -> TMCMCSettings:
-        return TMCMCSettings(particles=self.particles, chains=self.chains,
-                             seed=self.seed + offset, proposal_scale=self.proposal_scale,
-                             target_cov=self.target_cov, mcmc_steps=self.mcmc_steps,
-                             max_mcmc_steps=self.max_mcmc_steps,
-                             correlation_threshold=self.correlation_threshold)
+        """The sampler's settings alone, the seed moved by ``offset``."""
+        sampler = {name: getattr(self, name) for name in TMCMCSettings.__dataclass_fields__}
+        return TMCMCSettings(**sampler | {"seed": self.seed + offset})
 
     @property
     def base_threshold(self) -> float:
@@ -304,11 +298,12 @@ def candidate_reference(effect: str, nested: ModelFit, detection: Detection | No
     scan = scan_factor(effect, detection, priors)
     if nested.samples is None or len(nested.samples) < 2 * len(nested.names):
         return None
-    lowers = tuple(float(priors[n].lower) for n in nested.names)
-    inside = np.all(nested.samples >= np.asarray(lowers)[None, :], axis=1)
+    lowers, uppers = support(priors, nested.names)
+    inside = np.all((nested.samples >= np.asarray(lowers)[None, :])
+                    & (nested.samples < np.asarray(uppers)[None, :]), axis=1)
     try:
         gaussian = GaussianFactor.from_samples(tuple(nested.names), nested.samples[inside],
-                                               lowers, REFERENCE_WIDEN)
+                                               lowers, REFERENCE_WIDEN, uppers)
     except ValueError as err:  # a degenerate posterior: the scan alone, or the prior
         log.warning("no Gaussian start for %s (%s)", effect, err)
         return None if scan is None else Reference({scan.name: priors[scan.name]}, (scan,),
@@ -328,10 +323,9 @@ def map_reference(point, priors: Mapping[str, PriorSpec]) -> Reference | None:
     cov = np.zeros((p + 1, p + 1))
     cov[:p, :p] = np.asarray(point.cov) * REFERENCE_WIDEN**2
     cov[p, p] = (0.2 * point.theta[-1]) ** 2
-    lowers = tuple(float(priors[n].lower) for n in names)
     try:
         gaussian = GaussianFactor(names, tuple(map(float, point.theta)),
-                                  tuple(map(tuple, cov)), lowers)
+                                  tuple(map(tuple, cov)), *support(priors, names))
     except ValueError as err:
         log.warning("no Gaussian start at the MAP (%s): tempering from the prior", err)
         return None
@@ -355,13 +349,23 @@ def scan_factor(effect: str, detection: Detection | None,
     z = np.asarray(detection.z, dtype=float)[idx]
     stat = z**2 if probe.signed else np.maximum(z, 0.0) ** 2
     grid = np.unique(values)
-    lower = float(priors[name].lower)
+    (lower,), (upper,) = support(priors, (name,))
     if len(grid) < 3 or (np.isfinite(lower) and grid.min() <= lower):
         return None
     half = np.array([np.logaddexp.reduce(0.5 * stat[values == v]) for v in grid])
     step = float(np.median(np.diff(np.log(grid))))
-    return ScanFactor(name, tuple(grid.tolist()), (step,) * len(grid),
-                      tuple(np.exp(half - half.max()).tolist()), lower)
+    try:
+        return ScanFactor(name, tuple(grid.tolist()), (step,) * len(grid),
+                          tuple(np.exp(half - half.max()).tolist()), lower, upper)
+    except ValueError as err:  # the scan lies outside the prior
+        log.warning("no scan start for %s (%s)", effect, err)
+        return None
+
+
+def support(priors: Mapping[str, PriorSpec], names) -> tuple[tuple[float, ...], ...]:
+    """(lowers, uppers) of the priors of ``names``: where a reference may put particles."""
+    return (tuple(float(priors[n].lower) for n in names),
+            tuple(float(priors[n].upper) for n in names))
 
 
 #: A final TMCMC stage accepting at least this share of its moves had collapsed onto copies

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import sosfiltfilt
 
-from harvester.data.signals import butterworth_sos
+from harvester.data.signals import butterworth_sos, settling_samples
 from harvester.electrical import generator as gen
 from harvester.electrical.priors import MECHANICAL, MechanicalPrior
 from harvester.electrical.records import LoadedRecord
@@ -84,10 +84,13 @@ class ElectricalProblem:
                                self.oversample if oversample is None else oversample)
 
     def record_sums(self, p: dict[str, np.ndarray], rec: LoadedRecord):
-        """(acceleration SSE, voltage SSE, ok) per particle over the record's window."""
-        v, a, ok = self.simulate_record(p, rec)
-        s = rec.samples
+        """(acceleration SSE, voltage SSE, ok) per particle over the record's window. The
+        simulation stops where the zero-phase filter's end effect has decayed below 1e-12
+        (``settling_samples``) after the window, not at the record's end."""
         sos = butterworth_sos(1.0 / rec.dt, self.lowpass[0], int(self.lowpass[1]))
+        stop = min(rec.base_acc.size, rec.window[1] + settling_samples(sos))
+        v, a, ok = self.simulate_record(p, rec, base_acc=rec.base_acc[:stop])
+        s = rec.samples
         a_f = sosfiltfilt(sos, np.nan_to_num(a), axis=-1)
         sse_a = np.sum((a_f[:, s] - rec.rel_acc[s]) ** 2, axis=1)
         volts = gen.line_voltage_magnitude(v[:, s], a[:, s], p["K_e"], p["R_s"], p["L_s"],

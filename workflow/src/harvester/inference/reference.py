@@ -17,8 +17,12 @@ Factors:
     a multivariate Gaussian over several variables, truncated to the prior's support (e.g. a
     nested baseline's posterior, widened, for the parameters a candidate shares with it).
 ``ScanFactor``
-    a mixture of log-normals of x - lower for one variable (e.g. a resonance frequency where a
-    scan of the residual places it).
+    a mixture of log-normals of x - lower for one variable, truncated below the prior's upper
+    bound (e.g. a resonance frequency where a scan of the residual places it).
+
+Both factors are truncated to the priors' support and normalised there: a draw outside it
+would have no prior density (and no coordinate in PyMC's transformed space), and mass outside
+it would bias the evidence low.
 """
 
 from __future__ import annotations
@@ -27,6 +31,7 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
+from scipy import stats
 from scipy.special import logsumexp
 
 from harvester.inference.priors import PriorSpec
@@ -47,13 +52,15 @@ class Factor(Protocol):
 @dataclass(frozen=True)
 class ScanFactor:
     """Mixture of log-normals of x - lower (normals of x if lower is -inf) for one variable:
-    components at ``centres`` (x units) with log-widths ``widths`` and ``weights``."""
+    components at ``centres`` (x units) with log-widths ``widths`` and ``weights``, truncated
+    to x < upper and normalised there."""
 
     name: str
     centres: tuple[float, ...]
     widths: tuple[float, ...]
     weights: tuple[float, ...]
     lower: float = -np.inf
+    upper: float = np.inf
 
     def __post_init__(self) -> None:
         if not len(self.centres) == len(self.widths) == len(self.weights) > 0:
@@ -62,6 +69,8 @@ class ScanFactor:
             raise ValueError("widths must be positive and weights non-negative, not all 0")
         if np.isfinite(self.lower) and min(self.centres) <= self.lower:
             raise ValueError(f"centres must lie above the lower bound {self.lower}")
+        if self._log_inside() < np.log(0.01):
+            raise ValueError(f"the scan lies almost wholly above the upper bound {self.upper}")
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -77,23 +86,37 @@ class ScanFactor:
             return np.asarray(x, dtype=float)
         return np.log(np.maximum(np.asarray(x, dtype=float) - self.lower, 1e-300))
 
+    def _log_inside(self) -> float:
+        """log of the untruncated mixture's mass below ``upper``."""
+        if not np.isfinite(self.upper):
+            return 0.0
+        mu = self._y(np.asarray(self.centres))
+        z = (self._y(np.asarray(self.upper)) - mu) / np.asarray(self.widths, dtype=float)
+        return float(logsumexp(stats.norm.logcdf(z), b=self.normalised_weights))
+
     def log_density(self, x: np.ndarray) -> np.ndarray:
         x = np.asarray(x, dtype=float).reshape(-1)
         y = self._y(x)[:, None]
         mu = self._y(np.asarray(self.centres))[None, :]
         sd = np.asarray(self.widths, dtype=float)[None, :]
         comp = -0.5 * ((y - mu) / sd) ** 2 - np.log(sd) - LOG_SQRT_2PI
-        out = logsumexp(comp, axis=1, b=self.normalised_weights[None, :])
+        out = logsumexp(comp, axis=1, b=self.normalised_weights[None, :]) - self._log_inside()
         if np.isfinite(self.lower):
             out = np.where(x > self.lower, out - y[:, 0], -np.inf)
-        return out
+        return np.where(x < self.upper, out, -np.inf)
 
     def draw(self, rng: np.random.Generator, n: int) -> np.ndarray:
+        """n draws below ``upper``: the untruncated mixture's, those above it drawn again."""
+        x = self._draw_untruncated(rng, n)
+        while np.any(above := x >= self.upper):
+            x[above] = self._draw_untruncated(rng, int(above.sum()))
+        return x[:, None]
+
+    def _draw_untruncated(self, rng: np.random.Generator, n: int) -> np.ndarray:
         k = rng.choice(len(self.centres), size=n, p=self.normalised_weights)
         y = self._y(np.asarray(self.centres))[k] + \
             np.asarray(self.widths, dtype=float)[k] * rng.standard_normal(n)
-        x = self.lower + np.exp(y) if np.isfinite(self.lower) else y
-        return x[:, None]
+        return self.lower + np.exp(y) if np.isfinite(self.lower) else y
 
 
 #: Draws that estimate the share of a Gaussian factor inside the priors' support.
@@ -102,20 +125,25 @@ SUPPORT_DRAWS = 200_000
 
 @dataclass(frozen=True)
 class GaussianFactor:
-    """N(mean, cov) over ``names``, truncated to x_j >= lowers_j (normalised there)."""
+    """N(mean, cov) over ``names``, truncated to lowers_j <= x_j < uppers_j (normalised
+    there; no uppers: none)."""
 
     names: tuple[str, ...]
     mean: tuple[float, ...]
     cov: tuple[tuple[float, ...], ...]
     lowers: tuple[float, ...]
+    uppers: tuple[float, ...] | None = None
     _chol: np.ndarray = field(init=False, repr=False, compare=False)
     _log_inside: float = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         k = len(self.names)
         cov = np.asarray(self.cov, dtype=float)
-        if len(self.mean) != k or cov.shape != (k, k) or len(self.lowers) != k:
-            raise ValueError("mean, cov and lowers must match names")
+        if self.uppers is None:
+            object.__setattr__(self, "uppers", (np.inf,) * k)
+        if len(self.mean) != k or cov.shape != (k, k) or len(self.lowers) != k or \
+                len(self.uppers) != k:
+            raise ValueError("mean, cov, lowers and uppers must match names")
         try:
             chol = np.linalg.cholesky(cov)
         except np.linalg.LinAlgError:
@@ -128,7 +156,8 @@ class GaussianFactor:
         object.__setattr__(self, "_log_inside", float(np.log(inside)))
 
     def _inside(self, x: np.ndarray) -> np.ndarray:
-        return np.all(x >= np.asarray(self.lowers, dtype=float)[None, :], axis=1)
+        return np.all((x >= np.asarray(self.lowers, dtype=float)[None, :])
+                      & (x < np.asarray(self.uppers, dtype=float)[None, :]), axis=1)
 
     def log_density(self, x: np.ndarray) -> np.ndarray:
         x = np.atleast_2d(np.asarray(x, dtype=float))
@@ -148,13 +177,14 @@ class GaussianFactor:
 
     @classmethod
     def from_samples(cls, names: tuple[str, ...], samples: np.ndarray,
-                     lowers: tuple[float, ...], widen: float = 1.5) -> "GaussianFactor":
+                     lowers: tuple[float, ...], widen: float = 1.5,
+                     uppers: tuple[float, ...] | None = None) -> "GaussianFactor":
         """The samples' mean and covariance, the sds multiplied by ``widen``."""
         s = np.atleast_2d(np.asarray(samples, dtype=float))
         cov = np.atleast_2d(np.cov(s, rowvar=False)) * widen**2
         cov += np.diag(np.maximum(np.diag(cov), 1e-300) * 1e-9)  # keep it positive definite
         return cls(tuple(names), tuple(s.mean(axis=0).tolist()),
-                   tuple(tuple(r) for r in cov.tolist()), tuple(lowers))
+                   tuple(tuple(r) for r in cov.tolist()), tuple(lowers), uppers)
 
 
 @dataclass(frozen=True)

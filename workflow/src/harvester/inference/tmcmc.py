@@ -248,7 +248,11 @@ def fit_gaussian_mixture(x: np.ndarray, weights: np.ndarray, components: int,
     """Weighted EM fit of a Gaussian mixture with up to ``components`` components to the
     weighted particles, the number chosen by BIC (each component needs 5 d effective
     particles); covariances multiplied by ``widen``^2 (a proposal with lighter tails than
-    its target would stick at the target's tail points)."""
+    its target would stick at the target's tail points). Particles of weight zero do not
+    count."""
+    if not np.isfinite(x).all():
+        keep = weights > 0
+        x, weights = x[keep], weights[keep]
     w = weights / weights.sum()
     n_eff = 1.0 / np.sum(w**2)
     d = x.shape[1]
@@ -296,7 +300,11 @@ def _em(x: np.ndarray, w: np.ndarray, k: int, rng: np.random.Generator, iteratio
 
 
 def weighted_covariance(particles: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """Sum_k w_k (theta_k - mean)(theta_k - mean)^T with normalised weights (Ching & Chen)."""
+    """Sum_k w_k (theta_k - mean)(theta_k - mean)^T with normalised weights (Ching & Chen).
+    Particles of weight zero do not count, even where a coordinate is not finite."""
+    if not np.isfinite(particles).all():
+        keep = weights > 0
+        particles, weights = particles[keep], weights[keep]
     weights = weights / weights.sum()
     mean = weights @ particles
     centred = particles - mean
