@@ -26,7 +26,7 @@ test: $(STAMP)
 	$(BIN)/python -m pytest -n $(CORES) --dist loadfile
 
 test-slow: $(STAMP)
-	$(BIN)/python -m pytest -m slow
+	$(BIN)/python -m pytest -m slow -n $(CORES) --dist loadfile
 
 benchmark: $(STAMP)
 	$(BIN)/python benchmarks/bench_simulator.py

@@ -8,7 +8,10 @@ prepares it (the baseline's MAP, tempering, posterior and detection over the ana
 and the candidate (baseline + effect) is sampled by ``confirm.candidate_fit`` with the
 diagnosis's default ConfirmSettings but ``--chains`` chains and no re-runs. Printed per effect:
 each chain's log evidence and stated standard error, their standard deviation (goal: below 0.5
-nats), the median stated error, and the wall time.
+nats), the median stated error, and the wall time; then the same for the estimate the
+diagnosis decides on, bridge sampling from each chain's final population
+(``harvester.inference.evidence.chains_bridge_log_evidence``), and the pooled bridge estimate
+with its stated error.
 
 Run: ``python benchmarks/bench_evidence_spread.py`` (``make benchmark``; about 10 minutes per
 effect on 2 cores).
@@ -78,6 +81,12 @@ def main() -> None:
         print(f"  sd over chains {np.std(ev, ddof=1):.3f} nats (goal below 0.5), median stated "
               f"se {np.median(se):.3f}, baseline {base.log_evidence:.2f}, gain "
               f"{fit.tmcmc_log_evidence - base.tmcmc_log_evidence:+.2f} nats")
+        if fit.bridge is not None:
+            own = np.asarray(fit.bridge.chain_log_evidence)
+            print("  bridge per chain:       " + " ".join(f"{e:.2f}" for e in own))
+            print(f"  bridge sd over chains {np.std(own, ddof=1):.3f} nats; pooled "
+                  f"{fit.bridge.log_evidence:.2f} +- {fit.bridge.se:.2f} (formula "
+                  f"{fit.bridge.formula_se:.2f}); {len(own)} of {args.chains} chains kept")
 
 
 if __name__ == "__main__":

@@ -133,6 +133,32 @@ def test_likelihood_peaks_near_the_truth(loaded_1ohm):
     assert problem.parameter_names[:3] == tuple(f"ln_{n}" for n in MECHANICAL)
 
 
+def test_the_record_past_the_filters_settling_is_not_simulated(loaded_1ohm, monkeypatch):
+    """The likelihood stops the simulation settling_samples after its window (the rest of the
+    record cannot change the filtered z'' there); it equals the whole record's."""
+    import dataclasses
+
+    import harvester.electrical.problem as ep
+
+    truth = np.log([RIG["c_m"], RIG["friction"]["F_c"], RIG["friction"]["beta"]])
+    prior = mechanical_prior(np.exp(truth + 0.01 * np.random.default_rng(1).standard_normal(
+        (100, 3))), KNOWN)
+    record = dataclasses.replace(_record_from(loaded_1ohm), window=(128, 300))
+    problem = ElectricalProblem([record], "inductive", prior, (20.0, 8))
+    theta = np.tile([*truth, GEN.K_e, GEN.R_s, GEN.L_s, 0.03, 0.003], (3, 1))
+    theta[:, :3] += 0.02 * np.random.default_rng(2).standard_normal((3, 3))
+    seen = []
+    real = ep.simulate_loaded
+    monkeypatch.setattr(ep, "simulate_loaded", lambda *a, **k: seen.append(a[5].size)
+                        or real(*a, **k))
+    settling = ep.settling_samples(ep.butterworth_sos(256.0, 20.0, 8))
+    cut = problem.loglike(theta)
+    monkeypatch.setattr(ep, "settling_samples", lambda sos: 10**9)
+    whole = problem.loglike(theta)
+    assert seen == [300 + settling, record.base_acc.size] and 300 + settling < seen[1]
+    np.testing.assert_allclose(cut, whole, rtol=0, atol=1e-8)
+
+
 def test_weights_and_evidence_table():
     w = model_weights({"resistive": 0.0, "inductive": np.log(3.0)})
     assert w["inductive"] == pytest.approx(0.75) and sum(w.values()) == pytest.approx(1.0)
