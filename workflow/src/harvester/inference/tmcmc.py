@@ -242,6 +242,16 @@ class GaussianMixture:
         return self.means[k] + np.einsum("nij,nj->ni", self.chols[k], z)
 
 
+def _weighted_only(x: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The rows of x with positive weight, where a row is not finite (a particle of zero
+    likelihood may lie outside the transformed space); else x and weights as they are, so
+    that the sums keep their order."""
+    if np.isfinite(x).all():
+        return x, weights
+    keep = weights > 0
+    return x[keep], weights[keep]
+
+
 def fit_gaussian_mixture(x: np.ndarray, weights: np.ndarray, components: int,
                          rng: np.random.Generator, iterations: int = 50,
                          widen: float = 1.0) -> GaussianMixture:
@@ -249,10 +259,8 @@ def fit_gaussian_mixture(x: np.ndarray, weights: np.ndarray, components: int,
     weighted particles, the number chosen by BIC (each component needs 5 d effective
     particles); covariances multiplied by ``widen``^2 (a proposal with lighter tails than
     its target would stick at the target's tail points). Particles of weight zero do not
-    count."""
-    if not np.isfinite(x).all():
-        keep = weights > 0
-        x, weights = x[keep], weights[keep]
+    count (``_weighted_only``)."""
+    x, weights = _weighted_only(x, weights)
     w = weights / weights.sum()
     n_eff = 1.0 / np.sum(w**2)
     d = x.shape[1]
@@ -301,10 +309,8 @@ def _em(x: np.ndarray, w: np.ndarray, k: int, rng: np.random.Generator, iteratio
 
 def weighted_covariance(particles: np.ndarray, weights: np.ndarray) -> np.ndarray:
     """Sum_k w_k (theta_k - mean)(theta_k - mean)^T with normalised weights (Ching & Chen).
-    Particles of weight zero do not count, even where a coordinate is not finite."""
-    if not np.isfinite(particles).all():
-        keep = weights > 0
-        particles, weights = particles[keep], weights[keep]
+    Particles of weight zero do not count (``_weighted_only``)."""
+    particles, weights = _weighted_only(particles, weights)
     weights = weights / weights.sum()
     mean = weights @ particles
     centred = particles - mean
