@@ -33,7 +33,7 @@ def small_config() -> dict:
     cfg["rig"]["records"]["validation"]["duration_s"] = 12.0
     cfg["rig"]["static_test"]["repeats"] = 6
     cfg["preprocess"]["training_samples"] = 1700  # the diagnosis needs 6.8 s with the lead-in
-    cfg["tmcmc"].update(particles=200, chains=2, mcmc_steps=1)
+    cfg["tmcmc"].update(particles=200, chains=2, mcmc_steps=1, max_mcmc_steps=3)
     cfg["predictive"].update(samples=40, short_window_s=[2.0, 6.0])
     cfg["diagnosis"].update(particles=100, chains=1, rounds=1, top=2, bootstrap=60,
                             candidates=["tanh_friction", "cubic_stiffness"])
