@@ -22,11 +22,12 @@ import numpy as np
 from harvester.diagnosis.baseline import chain_problem
 from harvester.diagnosis.confirm import ConfirmSettings, bridge_evidence
 from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
-from harvester.inference.identify import identify, make_problem, posterior_theta
+from harvester.inference.identify import identify
+from harvester.inference.problems import make_problem
+from harvester.inference.posterior import posterior_theta, log_evidence
 from harvester.inference.priors import PriorSpec
 from harvester.inference.priors import priors_for
 from harvester.model.structures import structure
-from harvester.inference.tmcmc import log_evidence
 
 FS = 256.0
 PRIORS = {"c_m": PriorSpec("c_m", 110.0, 50.0, "N s/m"), "F_c": PriorSpec("F_c", 10.0, 5.0, "N"),

@@ -32,7 +32,7 @@ from harvester.diagnosis.detect import detect, estimate_temper
 from harvester.diagnosis.run import DiagnosisSettings, default_priors, velocity_bound
 from harvester.diagnosis.signatures import candidate_terms, motion_scale
 from harvester.diagnosis.spectral import filter_cutoff
-from harvester.inference.identify import make_problem
+from harvester.inference.problems import make_problem
 from harvester.synthetic.scenarios import ScenarioSettings, make_scenario
 
 

@@ -29,7 +29,7 @@ from harvester.diagnosis.confirm import ConfirmSettings, confirm, fit_structure
 from harvester.diagnosis.detect import DetectionSettings, detect, estimate_temper
 from harvester.diagnosis.run import default_priors
 from harvester.diagnosis.signatures import motion_scale
-from harvester.inference.identify import make_problem
+from harvester.inference.problems import make_problem
 from harvester.inference.priors import PriorSpec
 from harvester.synthetic.scenarios import ScenarioSettings, make_scenario
 from harvester.model.structures import structure

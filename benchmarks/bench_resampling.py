@@ -16,7 +16,7 @@ import numpy as np
 
 from harvester.diagnosis.baseline import chain_problem, fit_map
 from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
-from harvester.inference.identify import make_problem
+from harvester.inference.problems import make_problem
 from harvester.inference.priors import PriorSpec
 from harvester.data.signals import resample_recording, resampling_ratio
 

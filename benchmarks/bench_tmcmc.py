@@ -24,10 +24,11 @@ import yaml
 
 from harvester.data.daq import read_raw_record, to_accelerations
 from harvester.data.signals import filter_recording
-from harvester.inference.identify import make_problem
+from harvester.inference.problems import make_problem
 from harvester.inference.priors import prior_moments
 from harvester.inference.pymc_model import build_model
-from harvester.inference.tmcmc import log_evidence, run_tmcmc
+from harvester.inference.tmcmc import run_tmcmc
+from harvester.inference.posterior import log_evidence
 
 ROOT = Path(__file__).resolve().parents[1]
 

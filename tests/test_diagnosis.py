@@ -18,7 +18,7 @@ from harvester.diagnosis.detect import estimate_temper
 from harvester.diagnosis.rank import rank
 from harvester.diagnosis.spectral import filter_cutoff
 from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
-from harvester.inference.identify import make_problem
+from harvester.inference.problems import make_problem
 from harvester.inference.likelihood import DAQ_OVERSAMPLE
 from harvester.model.structures import Layout
 from harvester.inference.priors import PriorSpec

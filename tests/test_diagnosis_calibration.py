@@ -111,7 +111,7 @@ def test_evidence_acceptance_on_forced_candidates_at_most_5_percent():
     from harvester.diagnosis.detect import estimate_temper
     from harvester.diagnosis.run import default_priors
     from harvester.diagnosis.signatures import motion_scale
-    from harvester.inference.identify import make_problem
+    from harvester.inference.problems import make_problem
     from harvester.model.structures import structure
 
     effects = ["coulomb_friction", "stribeck_friction"]

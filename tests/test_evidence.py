@@ -121,7 +121,7 @@ def test_the_diagnosis_evidence_agrees_with_tmcmc_and_is_more_precise():
     from harvester.diagnosis.baseline import chain_problem
     from harvester.diagnosis.confirm import ConfirmSettings, fit_structure
     from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
-    from harvester.inference.identify import make_problem
+    from harvester.inference.problems import make_problem
     from harvester.inference.priors import PriorSpec
     from harvester.model.structures import structure
 

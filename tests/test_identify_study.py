@@ -7,7 +7,9 @@ import pytest
 import yaml
 
 from harvester.data.daq import read_raw_record, to_accelerations
-from harvester.inference.identify import TMCMCSettings, identify, make_problem, posterior_theta
+from harvester.inference.identify import TMCMCSettings, identify
+from harvester.inference.problems import make_problem
+from harvester.inference.posterior import posterior_theta
 from harvester.inference.priors import prior_moments
 from harvester.data.signals import filter_recording
 

@@ -5,7 +5,7 @@ import pandas as pd
 import pytest
 from scipy.signal import butter, sosfilt
 
-from harvester.inference.identify import make_problem
+from harvester.inference.problems import make_problem
 from harvester.inference.predictive import (NOMINAL_OUTSIDE, PredictiveBand, load_band, mlpd,
                                   posterior_predictive, save_band, validation_rows)
 

@@ -16,7 +16,8 @@ from scipy import signal
 from harvester.data import daq
 from harvester.data.errors import DataError
 from harvester.initial.frf import fit_linear_frf, initial_priors
-from harvester.inference.identify import TMCMCSettings, identify, make_problem
+from harvester.inference.identify import TMCMCSettings, identify
+from harvester.inference.problems import make_problem
 from harvester.model.structures import Layout
 from harvester.inference.priors import PriorSpec
 from harvester.data.recording import G, RecordingKinds, check_plausible, recording_kinds

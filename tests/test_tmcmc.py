@@ -21,13 +21,13 @@ from scipy.stats import multivariate_normal
 from harvester.inference.batched import BatchedLogLike, loglike_potential
 from harvester.inference.priors import PriorSpec
 from harvester.inference.reference import GaussianFactor, Reference, ScanFactor
+from harvester.inference.posterior import log_evidence
 from harvester.inference.tmcmc import (
     TMCMC,
     TMCMCError,
     compile_population_logp,
     fit_gaussian_mixture,
     weighted_covariance,
-    log_evidence,
     next_beta,
     run_tmcmc,
     weights_cov,

@@ -5,7 +5,7 @@ import numpy as np
 
 from harvester import emps
 from harvester.data.fileio import atomic_path, read_json, write_json
-from harvester.inference.identify import posterior_theta
+from harvester.inference.posterior import posterior_theta
 from harvester.inference.predictive import thin
 from harvester.runlog import rule_log
 

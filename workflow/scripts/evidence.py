@@ -4,9 +4,8 @@ import arviz as az
 
 from harvester.study import paper
 from harvester.data.fileio import atomic_path
-from harvester.inference.posterior import bayes_factor_table, evidence_table
+from harvester.inference.posterior import bayes_factor_table, evidence_table, log_evidence
 from harvester.runlog import rule_log
-from harvester.inference.tmcmc import log_evidence
 
 with rule_log(snakemake) as log:  # noqa: F821
     sm = snakemake  # noqa: F821

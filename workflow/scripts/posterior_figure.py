@@ -4,8 +4,7 @@ import arviz as az
 
 from harvester.study import paper
 from harvester.plots.posterior import pair_plot
-from harvester.inference.posterior import parameter_names, samples
-from harvester.inference.posterior import posterior_truth
+from harvester.inference.posterior import parameter_names, samples, posterior_truth
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

@@ -4,8 +4,7 @@ import arviz as az
 
 from harvester.study import paper
 from harvester.data.fileio import atomic_path
-from harvester.inference.posterior import summary_table
-from harvester.inference.posterior import posterior_truth
+from harvester.inference.posterior import summary_table, posterior_truth
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821

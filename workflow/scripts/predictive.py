@@ -4,7 +4,8 @@ import arviz as az
 
 from harvester.data.daq import read_recording
 from harvester.data.fileio import read_json
-from harvester.inference.identify import make_problem, posterior_theta
+from harvester.inference.problems import make_problem
+from harvester.inference.posterior import posterior_theta
 from harvester.inference.predictive import posterior_predictive, save_band, thin
 from harvester.runlog import rule_log
 

@@ -1,8 +1,8 @@
 """What a recording measures: the kind of its input and output columns, their units, plausibility.
 
-A converted recording (the input of ``harvester diagnose`` and of :func:`harvester.inference.identify.
-make_problem`) has a ``time`` column (s) and declares by its column names what drives the device
-and what was measured:
+A converted recording (the input of ``harvester diagnose`` and of
+:func:`harvester.inference.problems.make_problem`) has a ``time`` column (s) and declares by
+its column names what drives the device and what was measured:
 
 ========== ====== ===================================================================
 column     unit   meaning

@@ -26,11 +26,12 @@ from harvester.diagnosis.confirm import ModelFit, fit_structure, map_reference
 from harvester.diagnosis.detect import estimate_temper
 from harvester.diagnosis.settings import DiagnosisSettings
 from harvester.diagnosis.spectral import filter_cutoff
-from harvester.inference.identify import make_problem, posterior_theta
-from harvester.inference.likelihood import Problem
+from harvester.inference.problems import make_problem
+from harvester.inference.posterior import log_evidence as idata_log_evidence
 from harvester.inference.posterior import parameter_names as idata_parameter_names
+from harvester.inference.posterior import posterior_theta
+from harvester.inference.likelihood import Problem
 from harvester.inference.priors import PriorSpec, default_prior, priors_for
-from harvester.inference.tmcmc import log_evidence as idata_log_evidence
 from harvester.model.structures import ModelStructure
 from harvester.model.structures import structure as named_structure
 

@@ -52,14 +52,13 @@ from harvester.diagnosis.baseline import ChainProblem, chain_problem
 from harvester.diagnosis.detect import Detection, at_prior_edge
 from harvester.model.priors import DeviceScale
 from harvester.inference.evidence import BridgeEstimate, chains_bridge_log_evidence, log_target
-from harvester.inference.identify import TMCMCSettings, identify, posterior_theta
+from harvester.inference.identify import TMCMCSettings, identify
+from harvester.inference.posterior import posterior_theta, pooled_log_evidence, log_evidence
 from harvester.model.terms import same_physics, term
-from harvester.inference.posterior import pooled_log_evidence
 from harvester.inference.priors import PriorSpec
 from harvester.inference.priors import priors_for
 from harvester.inference.reference import GaussianFactor, Reference, ScanFactor
 from harvester.model.structures import ModelStructure
-from harvester.inference.tmcmc import log_evidence
 
 log = logging.getLogger("harvester.diagnosis")
 

@@ -33,7 +33,7 @@ from harvester.diagnosis.settings import DiagnosisSettings
 from harvester.diagnosis.signatures import candidate_terms
 from harvester.diagnosis.spectral import filter_cutoff
 from harvester.diagnosis.verdict import Conclusion, Tie, conclude, decide_verdict
-from harvester.inference.identify import make_problem
+from harvester.inference.problems import make_problem
 from harvester.inference.priors import PriorSpec
 from harvester.model.structures import ModelStructure
 from harvester.model.structures import structure as named_structure

@@ -111,7 +111,7 @@ def evidence_table(runs: Mapping[str, object], tie_nats: float = TIE_NATS
     ``harvester.diagnosis``.)
     """
     from harvester.inference.posterior import pooled_log_evidence
-    from harvester.inference.tmcmc import log_evidence
+    from harvester.inference.posterior import log_evidence
     rows = []
     for name, idata in runs.items():
         terms = model_terms(name)

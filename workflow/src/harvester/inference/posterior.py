@@ -102,3 +102,40 @@ def posterior_truth(config_rig: dict, model: str) -> dict[str, float]:
         return {}
     f = config_rig["friction"]
     return {"c_m": float(config_rig["c_m"]), "F_c": float(f["F_c"]), "beta": float(f["beta"])}
+
+
+def posterior_theta(idata: az.InferenceData) -> np.ndarray:
+    """Posterior rows theta = (free parameters..., sigma), chains pooled."""
+    return samples(idata, parameter_names(idata))
+
+
+def per_chain_stage_lists(values, chains: int) -> list[np.ndarray]:
+    """PyMC's SMC sample_stats entry -> one 1-D float array per chain.
+
+    ``pm.sample_smc`` stores each statistic as an object array: (1, chains) of per-chain lists
+    when chains ran different numbers of stages, (1, chains, stages) of numbers when they ran
+    the same number, (1, stages) for one chain. All become ``chains`` rows.
+    """
+    rows = np.asarray(values, dtype=object).reshape(chains, -1)
+    return [
+        np.concatenate([np.atleast_1d(np.asarray(item, dtype=float)) for item in row])
+        for row in rows
+    ]
+
+
+def log_evidence(idata: az.InferenceData) -> np.ndarray:
+    """Log evidence log P(D|M) of each chain.
+
+    Reads ``sample_stats.log_evidence`` (from `run_tmcmc`), or else the last finite entry of
+    PyMC's ``sample_stats.log_marginal_likelihood`` (any ``pm.sample_smc`` kernel).
+    """
+    stats = idata.sample_stats
+    if "log_evidence" in stats:
+        return np.asarray(stats["log_evidence"].values, dtype=float).reshape(-1)
+    raw = stats["log_marginal_likelihood"].values
+    chains = idata.posterior.sizes["chain"]  # PyMC's sample_stats has a dummy chain dim
+    out = []
+    for row in per_chain_stage_lists(raw, chains):
+        finite = row[np.isfinite(row)]
+        out.append(finite[-1] if finite.size else np.nan)
+    return np.array(out)

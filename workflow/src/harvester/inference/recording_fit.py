@@ -23,11 +23,12 @@ import pandas as pd
 from harvester.data.errors import DataError
 from harvester.data.fileio import atomic_path, write_json
 from harvester.data.signals import uniform_step
-from harvester.inference.identify import TMCMCSettings, identify, make_problem
+from harvester.inference.identify import TMCMCSettings, identify
+from harvester.inference.problems import make_problem
 from harvester.inference.likelihood import Problem
-from harvester.inference.posterior import parameter_names, pooled_log_evidence
+from harvester.inference.posterior import (log_evidence, parameter_names, posterior_theta,
+                                          pooled_log_evidence)
 from harvester.inference.priors import PriorSpec
-from harvester.inference.tmcmc import log_evidence
 
 log = logging.getLogger("harvester.inference.recording_fit")
 
@@ -157,7 +158,6 @@ def write_fit(fit: Fit, directory: Path, figures: bool = True,
         table.to_csv(tmp, index=False, float_format="%.6g")
     files = ["posterior.nc", "summary.csv"]
     if figures:
-        from harvester.inference.identify import posterior_theta
         from harvester.plots.posterior import pair_plot
         names = parameter_names(fit.idata)
         pair_plot(posterior_theta(fit.idata), names, directory / "posterior_pairs.png",

@@ -98,6 +98,7 @@ from pytensor.graph.traversal import toposort
 from pytensor.tensor.random.type import RandomGeneratorType
 from scipy.special import logsumexp
 
+from harvester.inference.posterior import per_chain_stage_lists
 from harvester.inference.reference import Reference
 
 __all__ = [
@@ -105,7 +106,6 @@ __all__ = [
     "TMCMC",
     "TMCMCError",
     "compile_population_logp",
-    "log_evidence",
     "mean_abs_correlation",
     "next_beta",
     "plausibility_log_weights",
@@ -849,20 +849,6 @@ STAGE_STATS = ("beta", "accept_rate", "log_mean_weight", "weights_cov", "ess", "
                "correlation", "imh_accept_rate")
 
 
-def _per_chain_stage_lists(values, chains: int) -> list[np.ndarray]:
-    """PyMC's SMC sample_stats entry -> one 1-D float array per chain.
-
-    ``pm.sample_smc`` stores each statistic as an object array: (1, chains) of per-chain lists
-    when chains ran different numbers of stages, (1, chains, stages) of numbers when they ran
-    the same number, (1, stages) for one chain. All become ``chains`` rows.
-    """
-    rows = np.asarray(values, dtype=object).reshape(chains, -1)
-    return [
-        np.concatenate([np.atleast_1d(np.asarray(item, dtype=float)) for item in row])
-        for row in rows
-    ]
-
-
 def _ragged_to_matrix(rows: list[np.ndarray]) -> np.ndarray:
     out = np.full((len(rows), max(len(r) for r in rows)), np.nan)
     for i, row in enumerate(rows):
@@ -880,7 +866,7 @@ def tidy_sample_stats(sample_stats: xr.Dataset, chains: int, wall_time: float) -
     ``n_evals_total``, ``wall_time_total``. Attributes keep PyMC's settings and add
     ``wall_time_s`` (whole run).
     """
-    raw = {name: _per_chain_stage_lists(sample_stats[name].values, chains)
+    raw = {name: per_chain_stage_lists(sample_stats[name].values, chains)
            for name in STAGE_STATS if name in sample_stats}
     chain = np.arange(chains)
     data = {
@@ -939,21 +925,3 @@ def run_tmcmc(
     wall_time = time.perf_counter() - start
     idata.sample_stats = tidy_sample_stats(idata.sample_stats, chains, wall_time)
     return idata
-
-
-def log_evidence(idata: az.InferenceData) -> np.ndarray:
-    """Log evidence log P(D|M) of each chain.
-
-    Reads ``sample_stats.log_evidence`` (from `run_tmcmc`), or else the last finite entry of
-    PyMC's ``sample_stats.log_marginal_likelihood`` (any ``pm.sample_smc`` kernel).
-    """
-    stats = idata.sample_stats
-    if "log_evidence" in stats:
-        return np.asarray(stats["log_evidence"].values, dtype=float).reshape(-1)
-    raw = stats["log_marginal_likelihood"].values
-    chains = idata.posterior.sizes["chain"]  # PyMC's sample_stats has a dummy chain dim
-    out = []
-    for row in _per_chain_stage_lists(raw, chains):
-        finite = row[np.isfinite(row)]
-        out.append(finite[-1] if finite.size else np.nan)
-    return np.array(out)

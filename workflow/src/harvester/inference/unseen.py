@@ -21,9 +21,8 @@ import pandas as pd
 from harvester.data.errors import DataError
 from harvester.data.recording import UNITS, recording_kinds
 from harvester.data.signals import uniform_step
-from harvester.inference.identify import posterior_theta
+from harvester.inference.posterior import posterior_theta, known_values
 from harvester.inference.likelihood import DAQ_OVERSAMPLE, Problem
-from harvester.inference.posterior import known_values
 from harvester.inference.predictive import (NOMINAL_OUTSIDE, PredictiveBand, mlpd, nrmse,
                                             outside_fraction, posterior_predictive, thin)
 from harvester.inference.recording_fit import END_EFFECTS_S

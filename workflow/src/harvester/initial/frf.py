@@ -284,9 +284,9 @@ def initial_priors(recording: pd.DataFrame, known: Mapping[str, float], free: tu
                    source: str = "<recording>") -> tuple[FrfFit, dict[str, PriorSpec]]:
     """FRF fit and the priors of the ``free`` base parameters and of sigma.
 
-    ``free`` is usually :func:`harvester.inference.identify.free_base_parameters` of the structure; the
-    returned priors go to :func:`harvester.inference.identify.identify` together with the friction
-    terms' priors (config or library defaults).
+    ``free`` is usually :func:`harvester.inference.problems.free_base_parameters` of the
+    structure; the returned priors go to :func:`harvester.inference.identify.identify` together
+    with the friction terms' priors (config or library defaults).
     """
     fit = fit_linear_frf(recording, known, band_hz, segment_s, reference, source)
     specs = frf_prior_specs(fit, free, rel_sd)
