@@ -27,9 +27,9 @@ from harvester.diagnosis.detect import estimate_temper
 from harvester.diagnosis.settings import DiagnosisSettings
 from harvester.diagnosis.spectral import filter_cutoff
 from harvester.inference.problems import make_problem
-from harvester.inference.posterior import log_evidence as idata_log_evidence
-from harvester.inference.posterior import parameter_names as idata_parameter_names
-from harvester.inference.posterior import posterior_theta
+from harvester.inference.posterior import (log_evidence as idata_log_evidence,
+                                          parameter_names as idata_parameter_names,
+                                          posterior_theta)
 from harvester.inference.likelihood import Problem
 from harvester.inference.priors import PriorSpec, default_prior, priors_for
 from harvester.model.structures import ModelStructure

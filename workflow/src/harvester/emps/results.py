@@ -14,6 +14,7 @@ import pandas as pd
 from harvester.emps.closed_loop import (BASELINE_TERMS, FREE_BASE, ClosedLoopProblem,
                                         emps_model_name, model_terms)
 from harvester.emps.data import PARAMETERS, PUBLISHED, UNITS, EmpsRecord
+from harvester.inference.posterior import log_evidence, pooled_log_evidence
 from harvester.model.terms import term
 
 log = logging.getLogger("harvester.emps")
@@ -110,8 +111,6 @@ def evidence_table(runs: Mapping[str, object], tie_nats: float = TIE_NATS
     if it beats the baseline by more than ``tie_nats``; else ''. (Stand-in for
     ``harvester.diagnosis``.)
     """
-    from harvester.inference.posterior import pooled_log_evidence
-    from harvester.inference.posterior import log_evidence
     rows = []
     for name, idata in runs.items():
         terms = model_terms(name)
