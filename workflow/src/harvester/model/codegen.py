@@ -8,7 +8,9 @@ Python module holding
                no term is chosen while integrating;
 ``integrate``  classical RK4 over a block of particles that share a sub-step count, with the
                particles innermost (struct of arrays) so that the compiler vectorises the
-               loop over them (4 doubles per AVX2 instruction);
+               loop over them (4 doubles per AVX2 instruction); a rate-independent state
+               (a term's ``displacement_update``, the Dahl friction) is advanced exactly
+               along each stage's screw displacement instead;
 
 ``integrate`` releases the GIL: ``harvester.model.simulate`` runs the blocks of a population
 in a pool of threads, each block followed at once by its acquisition (compiled once for every
@@ -60,6 +62,28 @@ def compiled(term_name: str, function: str):
 
 
 # --------------------------------------------------------------------------- the source
+
+
+@nb.njit(error_model="numpy", cache=True)
+def turning_point(w0, w1, dx, h):
+    """Displacement (m) at which the motion over a step reverses, on the cubic Hermite path
+    through (0, 0, w0) and (h, dx, w1); dx where it does not reverse (w0 w1 >= 0)."""
+    if w0 * w1 >= 0.0:
+        return dx
+    g = dx / h
+    # x'(s h) = a s^2 + b s + w0, s in (0, 1), one root there since w0 w1 < 0
+    a = 3.0 * w0 - 6.0 * g + 3.0 * w1
+    b = -4.0 * w0 + 6.0 * g - 2.0 * w1
+    if abs(a) < 1e-12 * (abs(b) + abs(w0)):
+        s = -w0 / b
+    else:
+        disc = max(b * b - 4.0 * a * w0, 0.0)
+        q = -0.5 * (b + (disc ** 0.5 if b >= 0.0 else -disc ** 0.5))
+        s = q / a
+        if not 0.0 <= s <= 1.0:
+            s = w0 / q
+    s = min(max(s, 0.0), 1.0)
+    return h * (w0 * (s - 2.0 * s * s + s ** 3) + w1 * (s ** 3 - s * s)) + dx * s * s * (3.0 - 2.0 * s)
 
 
 def _names(terms: tuple[Term, ...]) -> tuple[list[str], list[str]]:
@@ -126,24 +150,59 @@ def _rhs_source(terms: tuple[Term, ...], driver: str) -> str:
     return "\n".join(lines)
 
 
+def _exact_states(terms: tuple[Term, ...]) -> tuple[dict[int, int], str]:
+    """(state index -> term index) of the states advanced by their term's
+    ``displacement_update``, and the index of the screw displacement's rate in an rhs result
+    as text: z' (index 1), less the coupling's d' where the structure has one."""
+    _, states = _names(terms)
+    exact, k, rate = {}, 2, "{k}[1]"
+    for i, t in enumerate(terms):
+        if t.displacement_update is not None:
+            exact[k] = i
+        if t.kind == "coupling":
+            rate = f"({{k}}[1] - {{k}}[{k + 1}])"
+        k += t.n_states
+    return exact, rate
+
+
 def _step_source(terms: tuple[Term, ...], driver: str) -> str:
-    """The body of one RK4 step of particle c (indented for the loop it sits in)."""
+    """The body of one RK4 step of particle c (indented for the loop it sits in). A state
+    with a ``displacement_update`` is set at each stage, and at the end, to its exact value
+    after the screw displacement that the stage assumes (no RK4 of its own rate)."""
     params, states = _names(terms)
     n = len(states)
     p_args = ", ".join(f"p_{p}[c]" for p in params)
+    exact, rate = _exact_states(terms)
+    t_args = {i: "".join(f", p_{p}[c]" for p in terms[i].parameter_names)
+              for i in set(exact.values())}
     body = [f"y{j} = x{j}[c]" for j in range(n)]
     u = {"a": "ua", "b": "ub", "c": "uc"} if driver != "servo" else \
         {"a": "uu[c]", "b": "uu[c]", "c": "uu[c]"}
 
+    def value(j, k, scale):
+        if j in exact:
+            dx = f"{scale} * {rate.format(k=f'k{k - 1}')}"
+            return f"_update{exact[j]}(y{j}, {dx}{t_args[exact[j]]})"
+        return f"y{j} + {scale} * k{k - 1}[{j + 1}]"
+
     def call(k, inp, scale):
-        st = ", ".join(f"y{j}" if scale is None else f"y{j} + {scale} * k{k - 1}[{j + 1}]"
-                       for j in range(n))
+        st = ", ".join(f"y{j}" if scale is None else value(j, k, scale) for j in range(n))
         return f"k{k} = rhs({inp}, {st}, {p_args})"
 
     body += [call(1, u["a"], None), "row[c] = k1[0]",
              call(2, u["b"], "half"), call(3, u["b"], "half"), call(4, u["c"], "h")]
-    body += [f"x{j}[c] = y{j} + sixth * (k1[{j + 1}] + 2.0 * k2[{j + 1}] + 2.0 * k3[{j + 1}]"
-             f" + k4[{j + 1}])" for j in range(n)]
+    for j in range(n):
+        if j not in exact:
+            body.append(f"x{j}[c] = y{j} + sixth * (k1[{j + 1}] + 2.0 * k2[{j + 1}] + "
+                        f"2.0 * k3[{j + 1}] + k4[{j + 1}])")
+    if exact:
+        dx = " + ".join(f"{w}{rate.format(k=f'k{k}')}" for k, w in
+                        ((1, ""), (2, "2.0 * "), (3, "2.0 * "), (4, "")))
+        w_end = rate.format(k="rhs_end").replace("rhs_end[", "x").replace("]", "[c]")
+        body += [f"dx = sixth * ({dx})",
+                 f"turn = turning_point({rate.format(k='k1')}, {w_end}, dx, h)"]
+        body += [f"x{j}[c] = _update{i}(_update{i}(y{j}, turn{t_args[i]}), dx - turn"
+                 f"{t_args[i]})" for j, i in exact.items()]
     return "\n".join(body)
 
 
@@ -228,7 +287,8 @@ def source(terms: tuple[str, ...], driver: str) -> str:
     objs = tuple(term(n) for n in terms)
     imports = []
     for i, t in enumerate(objs):
-        for fn, local in (("force", "_force"), ("state_rates", "_rates"), ("masses", "_masses")):
+        for fn, local in (("force", "_force"), ("state_rates", "_rates"), ("masses", "_masses"),
+                          ("displacement_update", "_update")):
             if getattr(t, fn) is not None:
                 imports.append(f'{local}{i} = compiled("{t.name}", "{fn}")')
     jit = '@nb.njit(error_model="numpy", cache=True'
@@ -236,7 +296,7 @@ def source(terms: tuple[str, ...], driver: str) -> str:
         f'"""Generated by harvester.model.codegen: structure ({", ".join(terms) or "linear"}),'
         f' driver {driver}. Do not edit."""',
         "import numba as nb", "import numpy as np", "",
-        "from harvester.model.codegen import BLOW_UP, compiled", "", *imports, "", "",
+        "from harvester.model.codegen import BLOW_UP, compiled, turning_point", "", *imports, "", "",
         f'{jit})', _rhs_source(objs, driver), "", "",
         f"{jit}, nogil=True)", _integrate_source(objs, driver)])
 

@@ -19,7 +19,10 @@ of eq. 1). Kinds of term and the signature of their force law:
 
 ``screw``     f = force(w, *params) on the ball-screw side, w its velocity (w = z' unless
               the structure has a ``coupling``); with internal states h:
-              f = force(w, *h, *params), h' = state_rates(w, *h, *params)
+              f = force(w, *h, *params), h' = state_rates(w, *h, *params); states that
+              follow the path of the screw's displacement alone (rate-independent
+              hysteresis) may give h -> displacement_update(h, dx, *params), their exact
+              value after a monotone displacement dx, which the integrator then uses
 ``mass``      f = force(z, *params) on the mass, a function of its displacement
 ``inertia``   (M, m) = masses(M, m, *params): changes the effective and oscillating masses
 ``mode``      a secondary mode with states (u, u'): f = force(u, u', *params) on the mass,
@@ -132,7 +135,10 @@ class Term:
     Stribeck excess is over a sliding friction): a candidate only where one is in the
     structure. ``alike``: terms that describe the same physics in another form (a tanh law and
     Coulomb friction): naming either is naming the effect (:func:`same_physics`). ``n_states``:
-    internal states the term adds.
+    internal states the term adds. ``displacement_update`` (a ``screw`` term with one state
+    whose law is rate-independent): the state after a monotone screw displacement dx, exact,
+    so that the integrator advances the state by it and the state's own relaxation rate does
+    not bound the step.
     """
 
     name: str
@@ -146,6 +152,7 @@ class Term:
     n_states: int = 0
     state_rates: Callable | None = None
     masses: Callable | None = None
+    displacement_update: Callable | None = None
     refines: tuple[str, ...] = ()
     alike: tuple[str, ...] = ()
     source: str = field(default="", compare=False)  # the file that defines the term
@@ -186,6 +193,9 @@ def check_term(t: Term) -> None:
     needs_rates = t.kind == "mode" or (t.kind == "screw" and t.n_states > 0)
     if needs_rates and not callable(t.state_rates):
         problems.append("a term with internal states needs state_rates")
+    if t.displacement_update is not None and not (
+            t.kind == "screw" and t.n_states == 1 and callable(t.displacement_update)):
+        problems.append("displacement_update is for a screw term with one state")
     if t.kind == "inertia" and not callable(t.masses):
         problems.append("an inertia term needs masses")
     if t.kind in ("mode", "coupling") and t.n_states != 2:
@@ -277,7 +287,7 @@ def step_rates(terms: tuple[Term, ...], params: dict[str, np.ndarray],
 
     ``params`` maps every parameter of the base and the terms to an array (one value per
     particle); ``v_bound`` (m/s): the largest velocity assumed for velocity-dependent rates
-    (Dahl relaxation, quadratic damping), and Z_PER_V x it the largest displacement (a cubic
+    (quadratic damping), and Z_PER_V x it the largest displacement (a cubic
     spring); None: V_BOUND. A caller that knows the motion gives
     a tighter one. The largest of: damping rate (d force / d velocity) / mass, natural
     frequency sqrt(stiffness / mass) of every spring, contact and mode, and each term's own
