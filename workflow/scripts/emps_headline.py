@@ -1,15 +1,15 @@
 """Rule emps_headline: the EMPS study's numbers on one page (CSV and HTML)."""
 
-import arviz as az
 import pandas as pd
 
 from harvester import emps
 from harvester.data.fileio import atomic_path, read_json
 from harvester.runlog import rule_log
+from harvester.inference.posterior import read_posterior
 
 with rule_log(snakemake) as log:  # noqa: F821
     sm = snakemake  # noqa: F821
-    runtimes = {m: float(az.from_netcdf(p).sample_stats.attrs["wall_time_s"])
+    runtimes = {m: float(read_posterior(p).sample_stats.attrs["wall_time_s"])
                 for m, p in zip(sm.params.models, sm.input.posteriors)}
     table = emps.headline_table(pd.read_csv(sm.input.comparison), pd.read_csv(sm.input.evidence),
                                 read_json(sm.input.named), pd.read_csv(sm.input.validation),

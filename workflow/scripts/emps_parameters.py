@@ -1,15 +1,14 @@
 """Rule emps_parameters: identified M, Fv, Fc, offset beside the published values; figure."""
 
-import arviz as az
-
 from harvester import emps
 from harvester.emps.figures import posterior_figure
 from harvester.data.fileio import atomic_path, read_json
 from harvester.runlog import rule_log
+from harvester.inference.posterior import read_posterior
 
 with rule_log(snakemake) as log:  # noqa: F821
     sm = snakemake  # noqa: F821
-    idata = az.from_netcdf(sm.input.posterior)
+    idata = read_posterior(sm.input.posterior)
     table = emps.parameters_table(idata)
     idim = read_json(sm.input.data)["training"]["idim_ls"]["values"]
     comparison = emps.comparison_table(table, idim)

@@ -1,17 +1,16 @@
 """Rule emps_predictive: posterior ensemble of one model in the closed loop of one record."""
 
-import arviz as az
 import numpy as np
 
 from harvester import emps
 from harvester.data.fileio import atomic_path, read_json, write_json
-from harvester.inference.posterior import posterior_theta
+from harvester.inference.posterior import posterior_theta, read_posterior
 from harvester.inference.predictive import thin
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821
     sm = snakemake  # noqa: F821
-    idata = az.from_netcdf(sm.input.posterior)
+    idata = read_posterior(sm.input.posterior)
     rec = emps.load_emps(sm.input.record)
     known = read_json(sm.input.priors)["known"]
     problem = emps.closed_loop_problem(rec, emps.model_terms(sm.wildcards.model), known,

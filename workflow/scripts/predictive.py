@@ -1,18 +1,16 @@
 """Rule predictive: posterior predictive ensemble of a model for a record (training or unseen)."""
 
-import arviz as az
-
 from harvester.data.daq import read_recording
 from harvester.data.fileio import read_json
 from harvester.inference.problems import make_problem
-from harvester.inference.posterior import posterior_theta
+from harvester.inference.posterior import posterior_theta, read_posterior
 from harvester.inference.predictive import posterior_predictive, save_band, thin
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821
     sm = snakemake  # noqa: F821
     rec = read_recording(sm.input.data)
-    idata = az.from_netcdf(sm.input.posterior)
+    idata = read_posterior(sm.input.posterior)
     filt = idata.posterior.attrs.get("output_filter")
     problem = make_problem(rec, idata.posterior.attrs["model"], read_json(sm.input.priors)["known"],
                            output_filter=None if filt is None else (float(filt[0]), int(filt[1])))
