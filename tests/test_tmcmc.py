@@ -30,6 +30,7 @@ from harvester.inference.tmcmc import (
     weighted_covariance,
     next_beta,
     run_tmcmc,
+    still_rising,
     weights_cov,
 )
 
@@ -555,6 +556,14 @@ def test_correlation_of_a_population_with_itself_and_with_a_shuffle():
     x = rng.normal(size=(2000, 3))
     assert mean_abs_correlation(x, x) == pytest.approx(1.0)
     assert mean_abs_correlation(x, rng.permutation(x)) < 0.05
+
+
+def test_the_last_stage_moves_on_while_the_mean_log_posterior_rises():
+    """A population climbing by 1 nat per move against a standard error of 0.3 has not settled;
+    one that rose 0.2 over the last three moves has; fewer moves than the window never has."""
+    assert still_rising([0.0, 1.0, 2.0], se=0.3)
+    assert still_rising([0.0, 1.0, 2.0, 3.0, 4.0], se=0.3)
+    assert not still_rising([0.0, 4.0, 4.1, 4.2, 4.2], se=0.3)
 
 
 def test_stated_evidence_errors_cover_the_spread_of_chains(linear_gaussian):

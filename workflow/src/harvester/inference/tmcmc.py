@@ -28,7 +28,9 @@ One stage of `TMCMC` (the order in which PyMC's ``sample_smc`` calls the methods
     dimensions of |corr(start, now)| across particles falls below ``correlation_threshold``,
     at most ``max_mcmc_steps`` (PyMC's SMC kernels count their steps on the same correlation;
     Betz, Papaioannou and Straub 2016 on why TMCMC's fixed chains leave the population
-    correlated). Each move evaluates prior and likelihood of ALL N proposals in one call of a
+    correlated). At the last stage the moves also go on while the population's mean log
+    posterior still rises (``still_rising``), up to FINAL_MOVES_FACTOR x ``max_mcmc_steps``:
+    the posterior samples and the bridge estimate of the evidence read that population. Each move evaluates prior and likelihood of ALL N proposals in one call of a
     compiled, vectorised function.
 ``sample_stats``
     Per-stage statistics (``stats_dtypes_shapes``) and a progress line on the logger
@@ -111,6 +113,7 @@ __all__ = [
     "plausibility_log_weights",
     "run_tmcmc",
     "stage_log_variance",
+    "still_rising",
     "tidy_sample_stats",
     "weighted_covariance",
     "weights_cov",
@@ -123,6 +126,13 @@ RESAMPLING_SCHEMES = ("multinomial", "systematic")
 IMH_WIDEN = 1.2
 #: Independent proposals accepting less than this share are dropped for the rest of a stage.
 IMH_MIN_ACCEPT = 0.05
+#: At the last stage (beta = 1) the moves go on, up to this many times ``max_mcmc_steps``,
+#: while the population's mean log posterior still rises by more than its standard error over
+#: SETTLE_WINDOW moves (``still_rising``): the population that the posterior summaries and the
+#: bridge estimate of the evidence read must have settled, not only decorrelated (a Dahl
+#: friction's population decorrelated with its mean 17 nats below its best particle).
+FINAL_MOVES_FACTOR = 3
+SETTLE_WINDOW = 3
 
 
 class TMCMCError(RuntimeError):
@@ -201,6 +211,12 @@ def stage_log_variance(log_weights: np.ndarray, families: np.ndarray) -> float:
     mean = w.mean()
     var = n_families / (n_families - 1.0) * np.sum((totals - sizes * mean) ** 2) / n**2
     return float(var / mean**2)
+
+
+def still_rising(means: Sequence[float], se: float, window: int = SETTLE_WINDOW) -> bool:
+    """Whether a population's mean log density (one entry per move, the first before any)
+    rose by more than ``se`` over the last ``window`` moves: not yet settled."""
+    return len(means) <= window or means[-1] - means[-1 - window] > se
 
 
 def mean_abs_correlation(start: np.ndarray, now: np.ndarray) -> float:
@@ -713,15 +729,20 @@ class TMCMC(SMC_KERNEL):
 
     def mutate(self) -> None:
         """Metropolis moves of all particles (one batched evaluation each) until the population
-        decorrelates from its start (``mcmc_steps`` .. ``max_mcmc_steps``): independent
-        proposals from a Gaussian mixture fitted to the stage (``independent_moves``) and
-        random-walk proposals in turn; the independent ones are dropped for the rest of the
-        stage when they accept under IMH_MIN_ACCEPT."""
+        decorrelates from its start (``mcmc_steps`` .. ``max_mcmc_steps``) and, at the last
+        stage, until its mean log posterior settles (``still_rising``, up to
+        FINAL_MOVES_FACTOR x ``max_mcmc_steps``): independent proposals from a Gaussian
+        mixture fitted to the stage (``independent_moves``) and random-walk proposals in turn;
+        the independent ones are dropped for the rest of the stage when they accept under
+        IMH_MIN_ACCEPT."""
         n = self.tempered_posterior.shape[0]
         start = self.tempered_posterior.copy()
         accepted = steps = rw_steps = imh_accepted = imh_steps = 0
         use_imh = self.mixture is not None
-        while steps < self.max_mcmc_steps:
+        settle = self.beta >= 1.0 and self.max_mcmc_steps > self.mcmc_steps
+        limit = self.max_mcmc_steps * (FINAL_MOVES_FACTOR if settle else 1)
+        means = [self._mean_logp()]
+        while steps < limit:
             if use_imh and steps % 2 == 0:
                 got = self._independent_move()
                 imh_accepted += got
@@ -731,9 +752,12 @@ class TMCMC(SMC_KERNEL):
                 accepted += self._move()
                 rw_steps += 1
             steps += 1
+            means.append(self._mean_logp())
             if steps >= self.mcmc_steps:
                 self.correlation = mean_abs_correlation(start, self.tempered_posterior)
-                if self.correlation < self.correlation_threshold:
+                decorrelated = self.correlation < self.correlation_threshold
+                if (decorrelated or steps >= self.max_mcmc_steps) and not (
+                        settle and still_rising(means, self._se_logp())):
                     break
         self.steps_used = steps
         self.acc_rate = accepted / (n * rw_steps) if rw_steps else np.nan
@@ -742,6 +766,16 @@ class TMCMC(SMC_KERNEL):
         if self.target_accept is not None and rw_steps:
             factor = np.exp(2.0 * (self.acc_rate - self.target_accept))
             self.proposal_scale = float(np.clip(self.proposal_scale * factor, 1e-3, 5.0))
+
+    def _mean_logp(self) -> float:
+        """Mean tempered log density of the population's finite particles."""
+        logp = self.tempered_posterior_logp
+        return float(np.mean(logp[np.isfinite(logp)]))
+
+    def _se_logp(self) -> float:
+        """Standard error of :meth:`_mean_logp`."""
+        logp = self.tempered_posterior_logp[np.isfinite(self.tempered_posterior_logp)]
+        return float(np.std(logp) / np.sqrt(max(logp.size, 1)))
 
     def _independent_move(self) -> int:
         """One independent Metropolis-Hastings move of every particle, proposed from the
