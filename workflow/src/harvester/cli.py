@@ -426,9 +426,8 @@ def compare_command(args: argparse.Namespace) -> int:
 
 
 def predict_command(args: argparse.Namespace) -> int:
-    import arviz as az
-
     from harvester.data.fileio import atomic_directory, check_output_dir, write_json
+    from harvester.inference.posterior import read_posterior
     from harvester.inference.unseen import (posterior_structure, predict_unseen,
                                             unseen_problem, write_prediction)
     check_output_dir(args.out, inputs=(args.recording, args.posterior))
@@ -436,7 +435,7 @@ def predict_command(args: argparse.Namespace) -> int:
         raise DataError(args.posterior, "posterior not found (expected posterior.nc written by "
                         "harvester identify)")
     try:
-        idata = az.from_netcdf(args.posterior)
+        idata = read_posterior(args.posterior)
     except (OSError, ValueError) as err:
         raise DataError(args.posterior, f"cannot read as netCDF: {err}") from None
     _quiet_pymc()

@@ -252,12 +252,11 @@ def validate_model(posterior: str | Path, recording: str | Path, samples: int, s
     """Posterior predictive of a group's model on one of its validation recordings
     (``inference.unseen``: same kinds as the training recording, the posterior's device and
     output filter); writes predictive.csv, predictive.png and validation.json."""
-    import arviz as az
-
     from harvester.data.daq import read_checked_recording
+    from harvester.inference.posterior import read_posterior
     from harvester.inference.unseen import (posterior_structure, predict_unseen,
                                             unseen_problem, write_prediction)
-    idata = az.from_netcdf(posterior)
+    idata = read_posterior(posterior)
     _, known = posterior_structure(idata, str(posterior))
     checked = read_checked_recording(recording, known=known,
                                      known_from=f"the posterior {posterior}")
@@ -291,11 +290,10 @@ def diagnose_model(data: str | Path, validation: str | Path | None, posterior: s
     first validation recording (if any) for the before/after comparison; the window is the
     group's (``window_samples``), the settings config ``diagnosis`` (``DiagnosisSettings``),
     the low-pass the sidecar's. Writes diagnosis.json and its figures in ``out_dir``."""
-    import arviz as az
-
     from harvester.data.daq import read_checked_recording
     from harvester.data.sidecar import KnownParameters
     from harvester.diagnosis import DiagnosisSettings, diagnose_study
+    from harvester.inference.posterior import read_posterior
 
     known, priors = read_priors(priors_file)
     checked = read_checked_recording(data, known=known, known_from=str(priors_file))
@@ -308,7 +306,7 @@ def diagnose_model(data: str | Path, validation: str | Path | None, posterior: s
                             filter_order=int(settings["filter_order"]))
     lead_in, samples = window_samples(settings, 1.0 / checked.dt)
     return diagnose_study(checked.data, model, known, priors, unseen, diag_settings, out_dir,
-                          posterior=az.from_netcdf(posterior), lead_in=lead_in,
+                          posterior=read_posterior(posterior), lead_in=lead_in,
                           samples=samples)
 
 

@@ -7,15 +7,13 @@ import logging
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-import arviz as az
-
 from harvester.data.fileio import atomic_path, write_json
 from harvester.electrical.identify import device_of, evidence_summary, identify, posterior_samples
 from harvester.electrical.priors import MECHANICAL, mechanical_prior
 from harvester.electrical.problem import ElectricalProblem
 from harvester.electrical.records import load_record, read_meta
 from harvester.inference.identify import TMCMCSettings
-from harvester.inference.posterior import known_values, samples
+from harvester.inference.posterior import known_values, read_posterior, samples
 
 log = logging.getLogger("harvester.electrical")
 
@@ -31,7 +29,7 @@ def identify_structure(records: Sequence[str | Path], metas: Sequence[str | Path
     lowpass = (float(preprocess["lowpass_hz"]), int(preprocess["filter_order"]))
     loaded = [load_record(csv, read_meta(meta), *lowpass, cfg["lead_in_s"], cfg["fit_seconds"])
               for csv, meta in zip(records, metas)]
-    mech_post = az.from_netcdf(mechanical)
+    mech_post = read_posterior(mechanical)
     prior = mechanical_prior(samples(mech_post, list(MECHANICAL)), known_values(mech_post))
     log.info("mechanical prior (posterior of %s): %s", mechanical, prior.summary())
     problem = ElectricalProblem(loaded, structure, prior, lowpass,

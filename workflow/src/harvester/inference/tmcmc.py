@@ -30,7 +30,8 @@ One stage of `TMCMC` (the order in which PyMC's ``sample_smc`` calls the methods
     Betz, Papaioannou and Straub 2016 on why TMCMC's fixed chains leave the population
     correlated). At the last stage the moves also go on while the population's mean log
     posterior still rises (``still_rising``), up to FINAL_MOVES_FACTOR x ``max_mcmc_steps``:
-    the posterior samples and the bridge estimate of the evidence read that population. Each move evaluates prior and likelihood of ALL N proposals in one call of a
+    the posterior samples and the bridge estimate of the evidence read that population. Each
+    move evaluates prior and likelihood of ALL N proposals in one call of a
     compiled, vectorised function.
 ``sample_stats``
     Per-stage statistics (``stats_dtypes_shapes``) and a progress line on the logger
@@ -741,7 +742,7 @@ class TMCMC(SMC_KERNEL):
         use_imh = self.mixture is not None
         settle = self.beta >= 1.0 and self.max_mcmc_steps > self.mcmc_steps
         limit = self.max_mcmc_steps * (FINAL_MOVES_FACTOR if settle else 1)
-        means = [self._mean_logp()]
+        means = [self._logp_mean_se()[0]]
         while steps < limit:
             if use_imh and steps % 2 == 0:
                 got = self._independent_move()
@@ -752,12 +753,12 @@ class TMCMC(SMC_KERNEL):
                 accepted += self._move()
                 rw_steps += 1
             steps += 1
-            means.append(self._mean_logp())
+            means.append(self._logp_mean_se()[0])
             if steps >= self.mcmc_steps:
                 self.correlation = mean_abs_correlation(start, self.tempered_posterior)
                 decorrelated = self.correlation < self.correlation_threshold
                 if (decorrelated or steps >= self.max_mcmc_steps) and not (
-                        settle and still_rising(means, self._se_logp())):
+                        settle and still_rising(means, self._logp_mean_se()[1])):
                     break
         self.steps_used = steps
         self.acc_rate = accepted / (n * rw_steps) if rw_steps else np.nan
@@ -767,15 +768,11 @@ class TMCMC(SMC_KERNEL):
             factor = np.exp(2.0 * (self.acc_rate - self.target_accept))
             self.proposal_scale = float(np.clip(self.proposal_scale * factor, 1e-3, 5.0))
 
-    def _mean_logp(self) -> float:
-        """Mean tempered log density of the population's finite particles."""
-        logp = self.tempered_posterior_logp
-        return float(np.mean(logp[np.isfinite(logp)]))
-
-    def _se_logp(self) -> float:
-        """Standard error of :meth:`_mean_logp`."""
+    def _logp_mean_se(self) -> tuple[float, float]:
+        """Mean tempered log density of the population's finite particles, and its
+        standard error."""
         logp = self.tempered_posterior_logp[np.isfinite(self.tempered_posterior_logp)]
-        return float(np.std(logp) / np.sqrt(max(logp.size, 1)))
+        return float(np.mean(logp)), float(np.std(logp) / np.sqrt(max(logp.size, 1)))
 
     def _independent_move(self) -> int:
         """One independent Metropolis-Hastings move of every particle, proposed from the
