@@ -290,10 +290,11 @@ def diagnose_model(data: str | Path, validation: str | Path | None, posterior: s
     first validation recording (if any) for the before/after comparison; the window is the
     group's (``window_samples``), the settings config ``diagnosis`` (``DiagnosisSettings``),
     the low-pass the sidecar's. Writes diagnosis.json and its figures in ``out_dir``."""
+    import arviz as az
+
     from harvester.data.daq import read_checked_recording
     from harvester.data.sidecar import KnownParameters
     from harvester.diagnosis import DiagnosisSettings, diagnose_study
-    from harvester.inference.posterior import read_posterior
 
     known, priors = read_priors(priors_file)
     checked = read_checked_recording(data, known=known, known_from=str(priors_file))
@@ -306,7 +307,7 @@ def diagnose_model(data: str | Path, validation: str | Path | None, posterior: s
                             filter_order=int(settings["filter_order"]))
     lead_in, samples = window_samples(settings, 1.0 / checked.dt)
     return diagnose_study(checked.data, model, known, priors, unseen, diag_settings, out_dir,
-                          posterior=read_posterior(posterior), lead_in=lead_in,
+                          posterior=az.from_netcdf(posterior), lead_in=lead_in,
                           samples=samples)
 
 
