@@ -113,6 +113,7 @@ def test_too_few_samples_is_an_error():
                             np.random.default_rng(0))
 
 
+@pytest.mark.slow  # 4 TMCMC chains on a device record
 @pytest.mark.filterwarnings("ignore::UserWarning", "ignore::RuntimeWarning")
 def test_the_diagnosis_evidence_agrees_with_tmcmc_and_is_more_precise():
     """On a tanh-device record, the bridge estimate from TMCMC's final population lies within

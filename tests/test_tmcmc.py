@@ -465,6 +465,7 @@ def test_reference_finds_a_narrow_peak_the_prior_misses_and_keeps_the_evidence_e
     assert bridge.log_evidence == pytest.approx(exact, abs=max(0.3, 3 * bridge.se))
 
 
+@pytest.mark.slow  # 12 chains: a statistical check
 def test_reference_path_keeps_a_conjugate_evidence_exact_over_seeds():
     """Normal means with truncated priors; both factors of the reference placed off the
     posterior, so the evidence must come right through the weights, not the placement."""
@@ -566,6 +567,7 @@ def test_the_last_stage_moves_on_while_the_mean_log_posterior_rises():
     assert not still_rising([0.0, 4.0, 4.1, 4.2, 4.2], se=0.3)
 
 
+@pytest.mark.slow  # 16 chains: a statistical check
 def test_stated_evidence_errors_cover_the_spread_of_chains(linear_gaussian):
     """Default (adaptive) settings, 16 chains of 400 particles: each chain's error against the
     exact log evidence, over its stated standard error, spreads like a standard normal."""
