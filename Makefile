@@ -21,12 +21,13 @@ study: $(STAMP)
 emps: $(STAMP)
 	$(BIN)/snakemake --cores $(CORES) emps_all
 
-# One worker per core; a file's tests stay on one worker (they share module fixtures).
+# One worker per core; a file's tests stay on one worker (they share module fixtures); files
+# in the order of tests/conftest.py (the longest first), not by their number of tests.
 test: $(STAMP)
-	$(BIN)/python -m pytest -n $(CORES) --dist loadfile
+	$(BIN)/python -m pytest -n $(CORES) --dist loadfile --no-loadscope-reorder
 
 test-slow: $(STAMP)
-	$(BIN)/python -m pytest -m slow -n $(CORES) --dist loadfile
+	$(BIN)/python -m pytest -m slow -n $(CORES) --dist loadfile --no-loadscope-reorder
 
 benchmark: $(STAMP)
 	$(BIN)/python benchmarks/bench_simulator.py

@@ -15,14 +15,18 @@ ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = Path(sys.executable).with_name("snakemake")
 
 
-#: Test files whose module fixtures run a study (minutes): collected first, so that with one
-#: worker per core (``make test``: pytest-xdist, ``--dist loadfile``) they start at once.
-LONG_FILES = ("test_rules.py",)
+#: Test files that take a minute or more (``test_rules.py``'s fixtures run a study), longest
+#: first: collected first, so that with one worker per core (``make test``: pytest-xdist,
+#: ``--dist loadfile --no-loadscope-reorder``, which keeps this order) they start at once and
+#: the workers end together.
+LONG_FILES = ("test_rules.py", "test_workflow.py", "test_cli.py")
 
 
 def pytest_collection_modifyitems(items) -> None:
-    """Put the tests of ``LONG_FILES`` first (a stable sort keeps every file's order)."""
-    items.sort(key=lambda item: item.path.name not in LONG_FILES)
+    """Put the tests of ``LONG_FILES`` first, in that order (a stable sort keeps every file's
+    own order)."""
+    rank = {name: i for i, name in enumerate(LONG_FILES)}
+    items.sort(key=lambda item: rank.get(item.path.name, len(LONG_FILES)))
 
 
 def small_config() -> dict:
