@@ -1,11 +1,21 @@
-"""Pre-sliding friction with memory (Dahl 1968): the friction force h follows
+"""Pre-sliding friction with memory (Dahl 1968; LuGre, Canudas de Wit et al. 1995): the
+bristle force h follows
 
     h' = (F_hyst / delta_hyst) (w - |w| h / F_hyst),
 
 rising along a bristle of stiffness F_hyst / delta_hyst when the motion reverses and
-saturating at F_hyst while sliding. delta_hyst (m) is the pre-sliding displacement; delta
--> 0 is Coulomb friction. Dahl's law is LuGre's (Canudas de Wit et al. 1995) without its
-bristle damping and Stribeck part, and the first-order Bouc-Wen form.
+saturating at F_hyst while sliding, and the friction force is
+
+    f = h + c_hyst (w - |w| h / F_hyst),
+
+the bristle force and the bristles' damping, which acts only while they deflect (after a
+reversal; it vanishes once h saturates). delta_hyst (m) is the pre-sliding displacement;
+delta -> 0 is Coulomb friction. With c_hyst -> 0 it is Dahl's law (and the first-order
+Bouc-Wen form); with c_hyst it is LuGre's pre-sliding part (h = sigma_0 z_b, c_hyst =
+sigma_1), whose Stribeck part is a separate term (``stribeck_friction``). The damping has a
+parameter of its own, not one tied to F_hyst, because a record may show the bristle damping
+far more than the bristle force: in LuGre sigma_1 = 2 zeta sqrt(sigma_0 M), 10-1000 x a
+device's viscous damping, acting over micrometres.
 
 The law is rate-independent: dh / dx = (F_hyst s - h) / delta_hyst along a screw displacement x
 moving in the direction s, so after a monotone displacement dx
@@ -26,17 +36,17 @@ from harvester.model.priors import Prior
 from harvester.model.terms import Motion, Parameter, Probe, RateBound, Term
 
 
-def force(w, h, F_hyst, delta_hyst):
-    """f = h (N), the Dahl state."""
-    return h + 0.0 * w
+def force(w, h, F_hyst, delta_hyst, c_hyst):
+    """f = h + c_hyst (w - |w| h / F_hyst) (N): the bristle force and its damping."""
+    return h + c_hyst * (w - abs(w) * h / F_hyst)
 
 
-def state_rates(w, h, F_hyst, delta_hyst):
+def state_rates(w, h, F_hyst, delta_hyst, c_hyst):
     """h' = (F_hyst / delta_hyst) (w - |w| h / F_hyst) (N/s)."""
     return (F_hyst * w - abs(w) * h) / delta_hyst
 
 
-def displacement_update(h, dx, F_hyst, delta_hyst):
+def displacement_update(h, dx, F_hyst, delta_hyst, c_hyst):
     """h after a monotone screw displacement dx (m): the exact solution of the law (N)."""
     target = F_hyst * fm.sign(dx)
     return target + (h - target) * fm.exp(-abs(dx) / delta_hyst)
@@ -44,9 +54,11 @@ def displacement_update(h, dx, F_hyst, delta_hyst):
 
 def rate_bound(p: dict, motion: Motion) -> RateBound:
     """The bristle stiffness d h / d x <= 2 F / delta (just after a reversal from
-    saturation); the relaxation is advanced exactly (``displacement_update``)."""
+    saturation) and its damping d f / d w <= 2 c_hyst (|h| <= F); the relaxation is advanced
+    exactly (``displacement_update``)."""
     delta = np.maximum(np.abs(p["delta_hyst"]), 1e-9)
-    return RateBound(stiffness=2.0 * np.abs(p["F_hyst"]) / delta)
+    return RateBound(damping=2.0 * np.abs(p["c_hyst"]),
+                     stiffness=2.0 * np.abs(p["F_hyst"]) / delta)
 
 
 TERM = Term(
@@ -63,11 +75,19 @@ TERM = Term(
                 "polymer contacts) from 1/300 of the RMS displacement, below which the data "
                 "cannot tell it from Coulomb friction, to the RMS displacement itself"),
             "pre-sliding displacement F_hyst / (bristle stiffness)"),
+        Parameter("c_hyst", "N s/m", Prior(
+            "loguniform", 1e-3, 100.0, "force/v",
+            why="from a thousandth of the damping the motion shows, where the law is Dahl's, "
+                "to a hundred times it: LuGre's critically damped bristles, 2 sqrt(sigma_0 "
+                "M), reach 10-1000 x a device's viscous damping"),
+            "damping of the bristles while they deflect (LuGre's sigma_1)"),
     ),
-    equation="Dahl: h' = (F_hyst / delta_hyst) (w - |w| h / F_hyst), f = h",
-    description="pre-sliding friction with memory (Dahl model)",
+    equation="Dahl / LuGre: h' = (F_hyst / delta_hyst) (w - |w| h / F_hyst), "
+             "f = h + c_hyst (w - |w| h / F_hyst)",
+    description="pre-sliding friction with memory and bristle damping (Dahl, LuGre)",
     force=force, state_rates=state_rates, rate_bound=rate_bound,
     displacement_update=displacement_update,
     probe=Probe("F_hyst", lambda d: 0.1 * d.force,
-                shapes=lambda d: [{"delta_hyst": f * d.z} for f in (0.01, 0.1)]),
+                shapes=lambda d: [{"delta_hyst": f * d.z, "c_hyst": c * d.force / d.v}
+                                  for f in (0.01, 0.1) for c in (1e-3, 0.3)]),
     source=__file__)
