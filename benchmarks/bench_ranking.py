@@ -22,15 +22,13 @@ import numpy as np
 
 from harvester.data.daq import read_recording
 from harvester.data.fileio import read_json
-from harvester.diagnosis.analysis import check_recording, default_priors, resample_for_model
-from harvester.diagnosis.baseline import baseline_state, chain_problem, fit_map
+from harvester.diagnosis.analysis import default_priors
+from harvester.diagnosis.baseline import chain_problem, fit_map
 from harvester.diagnosis.confirm import candidate_priors
-from harvester.diagnosis.detect import detect, estimate_temper
 from harvester.diagnosis.rank import rank
+from harvester.diagnosis.run import quick_detect
 from harvester.diagnosis.settings import DiagnosisSettings
-from harvester.diagnosis.signatures import candidate_terms, motion_scale
-from harvester.diagnosis.spectral import filter_cutoff
-from harvester.inference.problems import make_problem
+from harvester.diagnosis.signatures import motion_scale
 from harvester.model.structures import structure
 
 
@@ -44,30 +42,17 @@ def objective(problem, fit) -> float:
 def compare(csv: str, effects: tuple[str, ...], lead_in_s: float = 1.0) -> None:
     truth = read_json(csv.replace(".csv", ".json"))
     known, base = truth["known"], structure(truth["baseline"])
-    rec, dt = check_recording(read_recording(csv), csv, lead_in_s, 0.0)
-    lowpass = filter_cutoff(rec["rel_acc"].to_numpy(), 1.0 / dt)
-    rec, _, dt, _ = resample_for_model(rec, None, dt, lowpass)
-    lead = int(round(lead_in_s / dt))
-
-    def problem_of(struct, temper):
-        raw = make_problem(rec, struct, known, window=(lead, len(rec)))
-        return chain_problem(raw, temper, lowpass, 8)
-
-    first = fit_map(problem_of(base, 1.0), {}, seed=0)
-    temper = estimate_temper(first.residual, (lead, len(rec)), 1.0 / dt,
-                             0.9 * (lowpass or 0.5 / dt))
-    problem = problem_of(base, temper)
-    specs = default_priors(base, float(first.theta[-1]))
-    mp = fit_map(problem, specs, seed=0)
-    state = baseline_state(problem, mp.samples(200, 0))
     settings = DiagnosisSettings(lead_in_s=lead_in_s, candidates=effects)
-    det = detect(state, problem.window, specs, candidate_terms(base.terms, effects),
-                 settings.detection(), time=rec["time"].to_numpy())
+    det, state = quick_detect(read_recording(csv), base, known, settings=settings)
+    problem = state.problem
+    specs = default_priors(base, float(state.theta[-1]))
+    mp = fit_map(problem, specs, seed=0)
     scale = motion_scale(state, problem.window, det.frame.f_high)
     fits = []
     for r in rank(det, state, specs):
         clock = time.perf_counter()
-        cand = problem_of(structure(f"{base.name}+{r.effect}"), temper)
+        cand = chain_problem(problem, problem.temper, problem.lowpass_hz, problem.filter_order,
+                             structure=structure(f"{base.name}+{r.effect}"))
         fit = fit_map(cand, {**specs, **candidate_priors(r.effect, scale, known)}, seed=0)
         fits.append((r, cand, fit, time.perf_counter() - clock))
     best = _best_baseline(problem, specs, mp, [f for _, _, f, _ in fits])
