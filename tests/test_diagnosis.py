@@ -309,3 +309,72 @@ def test_chains_are_enlarged_only_where_a_decision_lies_within_their_range():
     assert not _straddles(np.array([60.0, 61.2]), decisions, 1.0)     # far below: rejected
     assert not _straddles(np.array([300.0, 301.5]), decisions, 1.0)   # accepted, far behind
     assert _straddles(np.array([495.0, 496.5]), decisions, 1.0)       # a possible tie
+
+
+# --------------------------------------------------------------------------- the MAP screen
+
+
+@pytest.fixture(scope="module")
+def concealed_mode():
+    """A 16 s record with a secondary mode at half the noise RMS, its MAP baseline as the
+    nested fit (the evidence stand-in: its likelihood at the posterior mean), the scales."""
+    from harvester.diagnosis.confirm import ModelFit
+    from harvester.diagnosis.run import default_priors
+    from harvester.diagnosis.screen import max_loglike
+    from harvester.diagnosis.signatures import motion_scale
+    from harvester.inference.priors import priors_for
+    from harvester.model.structures import structure
+
+    sc = make_scenario("unmodelled_mode", 0.5, 11, ScenarioSettings(duration_s=16.0),
+                       masking=False)
+    det, state = run_detection(sc.recording, seed=1)
+    problem = state.problem
+    specs = {**default_priors(structure("tanh"), float(state.theta[-1])), **PRIORS}
+    stand_in = max_loglike(problem, state.samples.mean(axis=0))
+    nested = ModelFit(structure("tanh"), problem, state.samples, np.array([stand_in]),
+                      priors=priors_for(problem, specs))
+    return sc, det, nested, specs, motion_scale(state, problem.window, det.frame.f_high)
+
+
+def test_max_loglike_is_the_likelihood_at_its_best_sigma(concealed_mode):
+    from harvester.diagnosis.screen import max_loglike
+    _, _, nested, _, _ = concealed_mode
+    theta = nested.samples.mean(axis=0)
+    best = max_loglike(nested.problem, theta)
+    sigmas = theta[-1] * np.linspace(0.5, 1.5, 41)
+    rows = np.column_stack([np.tile(theta[:-1], (len(sigmas), 1)), sigmas])
+    assert best >= nested.problem.loglike(rows).max() - 1e-9
+    assert best == pytest.approx(nested.problem.loglike(rows).max(), abs=0.05)
+
+
+def test_the_screen_puts_a_concealed_mode_first_at_its_frequency(concealed_mode):
+    from harvester.diagnosis.screen import screen
+    sc, det, nested, specs, scale = concealed_mode
+    out = screen(nested, ["inertia_error", "cubic_stiffness", "unmodelled_mode"], specs, scale,
+                 det)
+    first, *others = out.candidates
+    assert first.effect == "unmodelled_mode" and not first.failed
+    f_mode = dict(zip(first.names, first.theta))["f_mode"]
+    assert f_mode == pytest.approx(sc.truth["shape"]["f_mode"], rel=0.02)
+    # every candidate contains the baseline, so none fits worse than it
+    assert all(s.max_loglike >= out.nested_loglike - 1e-6 for s in out.candidates)
+    assert first.bound > max(s.bound for s in others) + 20.0
+
+
+def _screened(effect, bound, failed=False):
+    from harvester.diagnosis.screen import Screened
+    return Screened(effect, (), np.zeros(1), 0.0, bound, bound + 30.0, failed, 0, 0.0)
+
+
+def test_a_candidate_is_sampled_unless_its_evidence_bound_rules_it_out():
+    from harvester.diagnosis.confirm import ConfirmSettings, skip_reason
+    cs = ConfirmSettings()  # acceptance at log(20) = 3.0 nats plus two standard errors
+    assert skip_reason(None, [], cs, 3) is None                      # not screened: sampled
+    assert skip_reason(_screened("end_stop", 2.0), [], cs, 3) is not None   # cannot pass
+    assert skip_reason(_screened("end_stop", 2.0, failed=True), [], cs, 3) is None
+    best = [_result("hysteresis", 400.0, se=0.5)]
+    # a rival whose best fit cannot reach the accepted gain minus the naming margin
+    assert "hysteresis gained 400.0" in skip_reason(_screened("unmodelled_mode", 390.0), best,
+                                                    cs, 3)
+    assert skip_reason(_screened("unmodelled_mode", 398.0), best, cs, 3) is None  # may tie
+    assert skip_reason(_screened("inertia_error", 398.0), best * 3, cs, 3) is not None  # top

@@ -152,6 +152,7 @@ class PointFit:
     residual: np.ndarray
     names: tuple[str, ...]
     n_simulations: int = 0
+    log_evidence_laplace: float = float("nan")  # :func:`laplace_log_evidence` (nats)
 
     def samples(self, n: int, seed: int = 0) -> np.ndarray:
         """Draws from the Laplace approximation (physical parameters), sigma held at its mode."""
@@ -219,8 +220,8 @@ def fit_map(problem: ChainProblem, priors: Mapping[str, PriorSpec], n_starts: in
     (u the prior coordinates, :class:`PriorCoordinates`; w_j = 0 for a flat prior; lambda =
     ``problem.temper``, r through the measurement chain), by trust-region least squares,
     started from the best of ``n_starts`` prior draws, the prior's centre and ``start`` (free
-    physical parameters, optional) evaluated in one batched simulation. Jacobians by forward
-    differences, one batched simulation each.
+    physical parameters, a vector or rows of them, optional) evaluated in one batched
+    simulation. Jacobians by forward differences, one batched simulation each.
     """
     coords = PriorCoordinates.of(problem, priors)
     w = coords.penalty
@@ -239,15 +240,17 @@ def fit_map(problem: ChainProblem, priors: Mapping[str, PriorSpec], n_starts: in
                                                                                   axis=1)
         return np.where(np.isfinite(val), val, np.inf)
 
-    extra = None if start is None else coords.u(start)
+    extra = None if start is None else np.array([coords.u(row) for row in np.atleast_2d(start)])
     u0 = _best_start(coords, n_starts, seed, objective_rows, extra)
     u = _least_squares(resid_u, u0, coords, temper, n)
-    return _point_fit(problem, coords, u, resid_u, temper, n, count)
+    sigma_prior = priors.get("sigma")  # None: no Laplace evidence (sigma has no default)
+    return _point_fit(problem, coords, u, resid_u, temper, n, count, sigma_prior)
 
 
 def _best_start(coords: PriorCoordinates, n_starts: int, seed: int, objective,
                 extra: np.ndarray | None = None) -> np.ndarray:
-    """The best of the prior's centre, ``n_starts`` draws from the priors and ``extra`` (u)."""
+    """The best of the prior's centre, ``n_starts`` draws from the priors and ``extra`` (rows
+    of u; rows with a non-finite value are left out)."""
     low, high = coords.bounds()
     rng = np.random.default_rng(seed)
     p = len(low)
@@ -257,8 +260,9 @@ def _best_start(coords: PriorCoordinates, n_starts: int, seed: int, objective,
                                  (n_starts, p))[:, flat]
     inside = lambda x: np.clip(x, low + 1e-6, high - 1e-6)  # noqa: E731
     rows = [inside(np.zeros(p)), inside(draws)]
-    if extra is not None and np.all(np.isfinite(extra)):
-        rows.append(inside(extra)[None, :])
+    if extra is not None:
+        extra = np.atleast_2d(extra)
+        rows.append(inside(extra[np.all(np.isfinite(extra), axis=1)]))
     candidates = np.vstack(rows)
     return candidates[int(np.argmin(objective(candidates)))]
 
@@ -300,7 +304,8 @@ def _least_squares(resid_u, u0: np.ndarray, coords: PriorCoordinates, temper: fl
 
 
 def _point_fit(problem: ChainProblem, coords: PriorCoordinates, u: np.ndarray, resid_u,
-               temper: float, n: int, count: list[int]) -> PointFit:
+               temper: float, n: int, count: list[int], sigma_prior: PriorSpec | None
+               ) -> PointFit:
     """The MAP's PointFit with its Laplace covariance (lambda J^T J / sigma^2 + diag(w))^-1 in
     u (J = d model / d u), mapped to the parameters (a tiny floor keeps flat, uninformed
     directions finite)."""
@@ -319,8 +324,33 @@ def _point_fit(problem: ChainProblem, coords: PriorCoordinates, u: np.ndarray, r
                                                         theta_phys)), sigma, count[0])
     pred, _ = problem.predicted(np.append(theta_phys, sigma))
     residual = problem.chain(problem.rel_acc) - pred[0]
+    evidence = float("nan") if sigma_prior is None else laplace_log_evidence(
+        coords, u, temper * jm.T @ jm / sigma**2, sigma, temper, n, sigma_prior)
     return PointFit(np.append(theta_phys, sigma), cov, residual, problem.parameter_names,
-                    count[0])
+                    count[0], evidence)
+
+
+def laplace_log_evidence(coords: PriorCoordinates, u: np.ndarray, fisher: np.ndarray,
+                         sigma: float, temper: float, n: int, sigma_prior: PriorSpec) -> float:
+    """Laplace approximation of the log evidence of the tempered eq. (10) at a MAP (nats):
+
+        log Z ~ log L(u, sigma) + log pi(u) + log pi(sigma) + (p + 1)/2 log 2 pi
+                + 1/2 log det H_u^-1 + 1/2 log (sigma^2 / (2 lambda n)),
+
+    L at sigma = the RMS residual, pi(u) the priors' densities in u (log pi_theta plus the log
+    Jacobians), H_u = ``fisher`` (lambda J^T J / sigma^2) plus the prior's precision in u: 1 per
+    parameter, also for a log-uniform prior, whose u spans sqrt(12) with unit variance (an
+    uninformed direction then counts as the prior's width, not as infinite). Exact for a
+    Gaussian posterior; on a curved or bounded one only an estimate."""
+    theta = coords.theta(u)[0]
+    d = coords.dtheta_du(u)
+    log_prior = sum(float(s.logpdf(x)) for s, x in zip(coords.specs, theta)) \
+        + float(np.sum(np.log(np.abs(d)))) + float(sigma_prior.logpdf(sigma))
+    log_like = -0.5 * temper * n * (np.log(2.0 * np.pi * sigma**2) + 1.0)
+    _, logdet = np.linalg.slogdet(fisher + np.eye(len(u)))
+    p = len(u)
+    return float(log_like + log_prior + 0.5 * (p + 1) * np.log(2.0 * np.pi) - 0.5 * logdet
+                 + 0.5 * np.log(sigma**2 / (2.0 * temper * n)))
 
 
 # --------------------------------------------------------------------------- sensitivities

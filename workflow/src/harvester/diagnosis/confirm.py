@@ -27,15 +27,16 @@ Particles. A candidate's TMCMC gets ``particles`` x (its added parameters / 2), 
 ``particles`` (``candidate_particles``): the secondary mode's four parameters hold a narrow
 peak in f_mode that few prior draws hit.
 
-Start. The TMCMC of a candidate with a ``Probe.start_shape`` (the secondary mode's frequency)
-tempers from a reference distribution, not from the prior (``harvester.inference.reference``,
-``candidate_reference``): half its initial particles take that shape from the detection's
-scan of it and the parameters the candidate shares with the model it extends from that
-model's posterior (widened); the other half come from the prior, which bounds the importance
-weights. The prior, the posterior and the evidence are unchanged; what changes is that the
-tempering no longer spends its first stages (and their resampling, which thins out the added
-parameters' values at random) re-finding the baseline's parameters, so the narrow peak in
-frequency survives to the stages where its likelihood gain counts. A population that
+Start. A candidate's TMCMC tempers from a reference distribution, not from the prior
+(``harvester.inference.reference``, :func:`start_of`): half its initial particles at its MAP
+with the Laplace covariance widened (``diagnosis.screen`` fitted it), as the baseline's
+start; where it was not fitted, at the nested model's posterior (widened) for the shared
+parameters and, for a ``Probe.start_shape`` (a mode's frequency), the detection's scan
+(:func:`candidate_reference`). The other half come from the prior, which bounds the
+importance weights. The prior, the posterior and the evidence are unchanged; what changes is
+that the tempering no longer spends its first stages (and their resampling, which thins out
+the added parameters' values at random) re-finding the likelihood's peak, so a narrow peak
+(in f_mode) survives to the stages where its likelihood gain counts. A population that
 collapsed all the same (:func:`collapsed`) is sampled again from the prior.
 """
 
@@ -44,6 +45,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import arviz as az
 import numpy as np
@@ -59,6 +61,9 @@ from harvester.inference.priors import PriorSpec
 from harvester.inference.priors import priors_for
 from harvester.inference.reference import GaussianFactor, Reference, ScanFactor
 from harvester.model.structures import ModelStructure
+
+if TYPE_CHECKING:
+    from harvester.diagnosis.screen import Screen
 
 log = logging.getLogger("harvester.diagnosis")
 
@@ -469,19 +474,18 @@ def _straddles(ev: np.ndarray, decisions: tuple[float, ...], margin: float) -> b
 def candidate_fit(baseline: ModelFit, effect: str, priors: Mapping[str, PriorSpec],
                   settings: ConfirmSettings, scale: DeviceScale,
                   detection: Detection | None = None, seed_offset: int = 0,
-                  decisions: tuple[float, ...] | None = None) -> ModelFit:
+                  decisions: tuple[float, ...] | None = None, point=None) -> ModelFit:
     """The baseline with one more term, sampled by TMCMC: its priors (the candidate's
     scaled to this device, ``priors`` winning), its particles (:func:`candidate_particles`)
-    and its start (:func:`candidate_reference`, sampled again from the prior if that
-    population collapsed)."""
+    and its start (:func:`start_of`, sampled again from the prior if that population
+    collapsed). ``point``: the candidate's MAP (``baseline.PointFit``) where it was fitted."""
     structure = baseline.structure.with_term(effect)
     specs = {**candidate_priors(effect, scale, baseline.problem.known), **priors}
     run = replace(settings, particles=candidate_particles(effect, settings.particles))
-    ref = candidate_reference(effect, baseline, detection, priors_for(
-        baseline.problem, specs, baseline.names + term(effect).parameter_names)) \
-        if settings.reference else None
+    ref, where = start_of(effect, baseline, detection, specs, settings, point) \
+        if settings.reference else (None, "")
     log.info("%s: %d particles per chain%s", structure.name, run.particles,
-             "" if ref is None else "; half the particles start from " + describe_start(ref))
+             "" if ref is None else "; half the particles start from " + where)
     fit = fit_structure(baseline.problem, structure, specs, run, seed_offset=seed_offset,
                         reference=ref, decisions=decisions)
     if ref is not None and collapsed(fit):
@@ -492,22 +496,88 @@ def candidate_fit(baseline: ModelFit, effect: str, priors: Mapping[str, PriorSpe
     return fit
 
 
+def start_of(effect: str, baseline: ModelFit, detection: Detection | None,
+             specs: Mapping[str, PriorSpec], settings: ConfirmSettings, point=None
+             ) -> tuple[Reference | None, str]:
+    """(reference, what it is) for a candidate's TMCMC: its own MAP with the Laplace
+    covariance (:func:`map_reference`) where the screen fitted it, as the baseline's starts;
+    else the nested model's posterior and the detection's scan (:func:`candidate_reference`).
+    With the MAP the tempering starts where the likelihood is, instead of at the added
+    parameters' priors, and needs a few stages instead of a dozen or more."""
+    names = baseline.names + term(effect).parameter_names
+    used = priors_for(baseline.problem, specs, names)
+    if point is not None:
+        ref = map_reference(point, used)
+        if ref is not None:
+            return ref, "the candidate's MAP and its Laplace covariance"
+    ref = candidate_reference(effect, baseline, detection, used)
+    return ref, "" if ref is None else describe_start(ref)
+
+
 def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSpec],
             settings: ConfirmSettings, scale: DeviceScale, seed_offset: int = 0,
-            detection: Detection | None = None) -> list[CandidateResult]:
+            detection: Detection | None = None, screen: "Screen | None" = None,
+            top: int | None = None) -> list[CandidateResult]:
     """Sample each augmented structure; evidence against the baseline; acceptance.
     ``detection``: the round's detection, whose scans place the start of candidates with a
-    ``Probe.start_shape`` (:func:`candidate_reference`)."""
+    ``Probe.start_shape`` (:func:`candidate_reference`). ``screen``: the candidates' best
+    fits (``diagnosis.screen``); then they are sampled in its order, at most ``top`` of them,
+    and one whose evidence bound rules it out is not sampled (:func:`skip_reason`)."""
+    bounds = {s.effect: s for s in screen.candidates} if screen is not None else {}
+    order = screen.order if screen is not None else list(effects)
     results = []
-    for i, effect in enumerate(effects):
+    for i, effect in enumerate(order):
+        reason = skip_reason(bounds.get(effect), results, settings, top,
+                             baseline.log_evidence_se)
+        if reason is not None:
+            bounds[effect].skipped = reason
+            log.info("%s not sampled: %s", effect, reason)
+            continue
         log.info("confirming %s (%d of %d)", baseline.structure.with_term(effect).name, i + 1,
-                 len(effects))
+                 len(order))
+        screened = bounds.get(effect)
+        point = screened.point if screened is not None and not screened.failed else None
         fit = candidate_fit(baseline, effect, priors, settings, scale, detection,
-                            seed_offset + 101 * (i + 1), decisions(baseline, results, settings))
+                            seed_offset + 101 * (i + 1), decisions(baseline, results, settings),
+                            point)
         results.append(judge(effect, fit, baseline, settings))
+        if effect in bounds:
+            bounds[effect].sampled = True
     results.sort(key=lambda r: -r.delta_log_evidence)
     mark_ties(results, settings)
     return results
+
+
+def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSettings,
+                top: int | None, nested_se: float = BRIDGE_MIN_SE) -> str | None:
+    """Why a screened candidate (``diagnosis.screen.Screened``) need not be sampled: ``top``
+    candidates were sampled already, or its evidence bound (``Screened.bound``) lies below the
+    acceptance threshold (log(1/alpha) plus mc_sigmas times the root sum of squares of the
+    nested model's standard error and BRIDGE_MIN_SE), or below the best accepted gain minus
+    the naming margin
+    (log(1/alpha) + mc_sigmas standard errors of that gain): it can then neither be accepted
+    nor tie with the best. None: sample it (always where it was not screened or its fit
+    failed)."""
+    if screened is None:
+        return None
+    if top is not None and len(results) >= top:
+        return f"the round's {top} best by their fits were sampled"
+    if screened.failed:
+        return None
+    least = settings.base_threshold + settings.mc_sigmas * float(np.hypot(nested_se,
+                                                                          BRIDGE_MIN_SE))
+    if screened.bound < least:
+        return (f"its best fit gains at most {screened.bound:.1f} nats of evidence, below the "
+                f"acceptance threshold {least:.1f}")
+    accepted = [r for r in results if r.accepted]
+    if accepted:
+        best = max(accepted, key=lambda r: r.delta_log_evidence)
+        floor = best.delta_log_evidence - settings.base_threshold \
+            - settings.mc_sigmas * best.delta_se
+        if screened.bound < floor:
+            return (f"its best fit gains at most {screened.bound:.1f} nats of evidence; "
+                    f"{best.effect} gained {best.delta_log_evidence:.1f}")
+    return None
 
 
 def decisions(baseline: ModelFit, results: list[CandidateResult], settings: ConfirmSettings

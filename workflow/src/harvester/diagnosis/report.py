@@ -198,6 +198,8 @@ def _rounds(d) -> list[dict]:
              "significant": rnd.detection.significant,
              "prior_conflict": rnd.detection.conflict,
              "sampled": [r.effect for r in rnd.confirmed],
+             "screened": ([s.to_dict() for s in rnd.screen.candidates]
+                          if rnd.screen is not None else []),
              "accepted": rnd.accepted.effect if rnd.accepted else None,
              "named": bool(rnd.accepted and rnd.accepted.named),
              "device_scale": asdict(rnd.scale) if rnd.scale is not None else None}

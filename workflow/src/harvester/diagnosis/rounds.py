@@ -1,8 +1,10 @@
 """Rounds of detect -> rank -> confirm: the diagnosis adds one effect at a time.
 
 Each round detects and locates the mismatch of the current structure (``detect``), ranks the
-library's effects by how much of it each explains (``rank``), samples the best few by TMCMC
-and judges them by evidence (``confirm``), and adopts the best accepted one. It stops when
+library's effects by how much of it each explains (``rank``), fits the best ``screen`` of them
+by MAP for a bound on the evidence each can gain (``screen``), samples the best few by that
+bound by TMCMC, skipping those the bound rules out, judges them by evidence (``confirm``),
+and adopts the best accepted one. It stops when
 nothing is detected, nothing is worth sampling, nothing sampled is accepted, or after
 ``settings.rounds`` additions.
 """
@@ -19,6 +21,7 @@ from harvester.diagnosis.baseline import BaselineState, baseline_state
 from harvester.diagnosis.confirm import CandidateResult, ModelFit, confirm, fit_structure
 from harvester.diagnosis.detect import Detection, detect
 from harvester.diagnosis.rank import RankedCandidate, rank, to_confirm
+from harvester.diagnosis.screen import Screen, screen
 from harvester.diagnosis.settings import DiagnosisSettings
 from harvester.diagnosis.signatures import candidate_terms, motion_scale
 from harvester.model.priors import DeviceScale
@@ -37,6 +40,7 @@ class Round:
     ranked: list[RankedCandidate]
     confirmed: list[CandidateResult] = field(default_factory=list)
     scale: DeviceScale | None = None  # the scales the candidates' priors were read on
+    screen: Screen | None = None  # the candidates' best fits, in the order they were sampled
 
     @property
     def accepted(self) -> CandidateResult | None:
@@ -68,7 +72,7 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
         det = rnd.detection
         if r == settings.rounds or not (det.significant or det.conflict):
             break
-        chosen = to_confirm(rnd.ranked, det, settings.top)
+        chosen = to_confirm(rnd.ranked, det, settings.screen)
         if not chosen:
             unexplained = unexplained or det.significant
             if det.significant:
@@ -80,9 +84,11 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
                                     settings.confirmation())
             baseline_fit = baseline_fit or now.fit
         scale = rnd.scale = motion_scale(rnd.state, analysis.window, det.frame.f_high)
-        rnd.confirmed = confirm(now.fit, [c.effect for c in chosen], now.priors,
-                                settings.confirmation(), scale, seed_offset=1000 * (r + 1),
-                                detection=det)
+        effects = [c.effect for c in chosen]
+        rnd.screen = screen(now.fit, effects, now.priors, scale, det, settings.seed + r)
+        rnd.confirmed = confirm(now.fit, effects, now.priors, settings.confirmation(), scale,
+                                seed_offset=1000 * (r + 1), detection=det, screen=rnd.screen,
+                                top=settings.top)
         best = rnd.accepted
         if best is None:
             unexplained = unexplained or det.significant

@@ -13,8 +13,10 @@ from harvester.diagnosis.detect import DetectionSettings
 class DiagnosisSettings:
     """Settings of :func:`diagnose` (defaults: a 40 s recording in minutes on 2 cores).
 
-    particles, chains, seed: TMCMC; rounds: most effects added one after the other; top:
-    candidates sampled per round; bootstrap, artifact_components, alpha, window_s: detection
+    particles, chains, seed: TMCMC; rounds: most effects added one after the other; screen:
+    candidates fitted by MAP per round (the best by the detection's ranking,
+    ``rank.to_confirm``), whose fits bound the evidence each can gain (``screen``); top:
+    candidates sampled per round, the best by that bound, none that it rules out; bootstrap, artifact_components, alpha, window_s: detection
     (``DetectionSettings``); evidence_alpha: acceptance
     (``ConfirmSettings``); unexplained_alpha: a detection that no library effect explains
     counts as missing physics only below this p-value (an effect confirmed by evidence
@@ -38,6 +40,7 @@ class DiagnosisSettings:
     chains: int = 2
     seed: int = 0
     rounds: int = 2
+    screen: int = 6
     top: int = 3
     bootstrap: int = 400
     artifact_components: int = 60
@@ -60,7 +63,7 @@ class DiagnosisSettings:
     def fast(cls, **overrides) -> "DiagnosisSettings":
         """Cheaper settings for grids of many recordings only: one round, two candidates,
         fewer particles and replicates, 10 s fitted (:meth:`trades` says what they give up)."""
-        base = dict(particles=150, rounds=1, top=2, bootstrap=300, artifact_components=30,
+        base = dict(particles=150, rounds=1, screen=4, top=2, bootstrap=300, artifact_components=30,
                     fit_seconds=10.0, predictive_samples=40, enlargements=1)
         return cls(**{**base, **overrides})
 
@@ -75,6 +78,7 @@ class DiagnosisSettings:
         for name, what in (("particles", "TMCMC particles per chain"),
                            ("chains", "TMCMC chains"),
                            ("rounds", "rounds of effects added in turn"),
+                           ("screen", "candidates fitted by MAP per round"),
                            ("top", "candidates sampled per round"),
                            ("bootstrap", "noise replicates of the detection"),
                            ("artifact_components", "filter-artefact replicates"),
