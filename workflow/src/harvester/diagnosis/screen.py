@@ -10,20 +10,23 @@ as the nested model's sampled evidence:
   max log L_candidate - log Z_nested. It exceeds the true gain by the nested model's Occam
   factor as well as the candidate's (tens of nats), too loose to rule out anything in a
   second round.
-* ``bound``: the likelihood gain, max log L_candidate - max log L_nested, plus GAIN_SLACK. In
-  the Laplace picture log Z = max log L - Occam, and the candidate's Occam factor is the
-  nested one's (its shared parameters at fixed added ones) plus that of the added
-  parameters, -log(pi(phi_hat) sqrt(det 2 pi Sigma_phi)), which is not negative while their
+* ``bound``: the gain in log L plus the log prior density of the parameters both models
+  share (sigma among them), each at its best fit, plus GAIN_SLACK. In the Laplace picture
+  log Z = max log L + log pi(theta_hat) + 1/2 log det(2 pi Sigma), and the candidate's last
+  two terms are the shared parameters' (at fixed added ones) plus those of the added
+  parameters, log(pi(phi_hat) sqrt(det 2 pi Sigma_phi)), which is not positive while their
   posterior is no wider than their prior (an added parameter the data leave at its prior
-  costs nothing, and gains nothing). So the evidence gain does not exceed the likelihood
-  gain, to within the Laplace picture's error, which GAIN_SLACK allows for.
+  costs nothing, and gains nothing). So the evidence gain does not exceed that gain, to
+  within the Laplace picture's error, which GAIN_SLACK allows for. The shared prior counts:
+  a candidate that moves the parameters back from a prior conflict (friction added to a
+  linear model whose damping had run far above its prior) gains that as evidence too.
 
 A candidate whose ``bound`` lies below the acceptance threshold cannot be accepted, and one
 whose bound lies below the best accepted gain minus the naming margin cannot tie with it
 (``confirm.skip_reason``): neither needs TMCMC. The bound misleads where the MAP misses the
 best fit: the fit starts from the best of the nested posterior's mean joined with prior draws
 of the added parameters and, for a start shape (a mode's frequency), the detection's scan; a
-fit below the nested model's best likelihood (impossible at the optimum of a model that
+fit below the nested model's best (impossible at the optimum of a model that
 contains the nested one) is marked ``failed`` and never screened out. Each candidate's
 Laplace log evidence (``baseline.laplace_log_evidence``) minus the nested model's is reported
 beside it.
@@ -54,9 +57,8 @@ log = logging.getLogger("harvester.diagnosis")
 ADDED_STARTS = 24
 #: Scanned values of a start shape (heaviest first) joined with the nested mean as starts.
 SCAN_STARTS = 3
-#: Nats allowed between the MAP's likelihood and the largest one (the MAP trades a little
-#: likelihood for prior density where the prior is not flat), and for the Laplace picture's
-#: error in ``bound``.
+#: Nats allowed for the MAP's distance from the best fit and for the Laplace picture's error
+#: in ``bound``.
 GAIN_SLACK = 1.0
 
 
@@ -68,9 +70,9 @@ class Screened:
     names: tuple[str, ...]
     theta: np.ndarray  # the MAP (free parameters..., sigma)
     max_loglike: float  # tempered log L at the MAP, sigma profiled (nats)
-    bound: float  # likelihood gain over the nested model's best + GAIN_SLACK (nats)
+    bound: float  # gain in log L + shared log prior over the nested model's + GAIN_SLACK
     strict_bound: float  # max log L - the nested model's log evidence (nats)
-    failed: bool  # the fit fell below the nested model's best likelihood
+    failed: bool  # the fit fell below the nested model's best (``fit_value``)
     simulations: int
     seconds: float
     laplace_gain: float = float("nan")  # Laplace log evidence minus the nested model's (nats)
@@ -95,6 +97,7 @@ class Screen:
 
     candidates: list[Screened] = field(default_factory=list)
     nested_loglike: float = float("nan")  # the nested model's best: its MAP or posterior mean
+    nested_value: float = float("nan")  # its best log L plus log prior (``fit_value``)
     nested_laplace: float = float("nan")  # the nested model's Laplace log evidence
 
     @property
@@ -105,13 +108,29 @@ class Screen:
 def max_loglike(problem, theta: np.ndarray) -> float:
     """The tempered log-likelihood at ``theta`` (free parameters, sigma ignored) with sigma
     at its maximum, sqrt(SSE / n) (nats; -inf where the simulation fails)."""
+    return _profiled(problem, theta)[0]
+
+
+def _profiled(problem, theta: np.ndarray) -> tuple[float, float]:
+    """(max log L over sigma, that sigma) at the free parameters of ``theta``."""
     row = np.append(np.asarray(theta, dtype=float)[:len(problem.structure.free_parameters)],
                     1.0)[None, :]
     sse, ok = problem.residual_sums(row)
     if not ok[0] or not np.isfinite(sse[0]) or sse[0] <= 0.0:
-        return -np.inf
+        return -np.inf, np.nan
     row[0, -1] = np.sqrt(sse[0] / problem.n_data)
-    return float(problem.loglike(row)[0])
+    return float(problem.loglike(row)[0]), float(row[0, -1])
+
+
+def fit_value(problem, theta: np.ndarray, priors: Mapping[str, PriorSpec],
+              names: tuple[str, ...]) -> tuple[float, float]:
+    """(max log L over sigma, that plus the log prior densities of ``names`` (sigma among
+    them) at ``theta``): what ``Screened.bound`` compares, the likelihood and the prior of
+    the parameters both models share (a candidate that moves them back from a prior
+    conflict gains that too)."""
+    ll, sigma = _profiled(problem, theta)
+    values = dict(zip(problem.parameter_names, [*np.asarray(theta)[:-1], sigma]))
+    return ll, ll + float(sum(priors[n].logpdf(values[n]) for n in names))
 
 
 def screen(nested: ModelFit, effects: list[str], priors: Mapping[str, PriorSpec],
@@ -120,8 +139,11 @@ def screen(nested: ModelFit, effects: list[str], priors: Mapping[str, PriorSpec]
     ``bound`` (failed fits last)."""
     nested_mean = nested.samples.mean(axis=0)
     point = fit_map(nested.problem, nested.priors, seed=seed, start=nested_mean[:-1])
-    out = Screen(nested_loglike=max(max_loglike(nested.problem, nested_mean),
-                                    max_loglike(nested.problem, point.theta)),
+    names = nested.names
+    fits = [fit_value(nested.problem, th, nested.priors, names)
+            for th in (nested_mean, point.theta)]
+    out = Screen(nested_loglike=max(ll for ll, _ in fits),
+                 nested_value=max(v for _, v in fits),
                  nested_laplace=point.log_evidence_laplace)
     for effect in effects:
         out.candidates.append(_screen_one(nested, effect, priors, scale, detection, seed,
@@ -146,10 +168,10 @@ def _screen_one(nested: ModelFit, effect: str, priors: Mapping[str, PriorSpec],
     specs = {**candidate_priors(effect, scale, p.known), **priors}
     starts = _starts(problem, specs, nested, nested_mean, effect, detection, seed)
     fit = fit_map(problem, specs, seed=seed, start=starts)
-    ll = max_loglike(problem, fit.theta)
-    return Screened(effect, problem.parameter_names, fit.theta, ll,
-                    ll - so_far.nested_loglike + GAIN_SLACK, ll - nested.log_evidence,
-                    not ll >= so_far.nested_loglike - GAIN_SLACK, fit.n_simulations,
+    ll, value = fit_value(problem, fit.theta, {**specs, **nested.priors}, nested.names)
+    gain = value - so_far.nested_value
+    return Screened(effect, problem.parameter_names, fit.theta, ll, gain + GAIN_SLACK,
+                    ll - nested.log_evidence, not gain >= -GAIN_SLACK, fit.n_simulations,
                     time.perf_counter() - clock,
                     fit.log_evidence_laplace - so_far.nested_laplace, point=fit)
 
