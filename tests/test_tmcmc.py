@@ -580,3 +580,31 @@ def test_stated_evidence_errors_cover_the_spread_of_chains(linear_gaussian):
     assert 0.5 < np.sqrt(np.mean(z**2)) < 2.0, (err, se)
     moves = idata.sample_stats["mcmc_steps"].values
     assert np.nanmax(moves) <= 30 and np.nanmin(moves) >= 2
+
+
+def test_component_steps_leave_a_two_cluster_target_invariant():
+    # Metropolis-Hastings with steps from each particle's own component, on a target made of
+    # two clusters of very different sizes: exact draws stay exact draws (detailed balance
+    # holds only with the Hastings term, since a step can land in the other component)
+    from harvester.inference.tmcmc import GaussianMixture, component_steps
+
+    means = np.array([[0.0, 0.0], [6.0, 1.0]])
+    chols = np.array([np.diag([0.05, 0.1]), np.array([[1.5, 0.0], [0.9, 1.2]])])
+    target = GaussianMixture(np.array([0.3, 0.7]), means, chols)
+    proposal = GaussianMixture(np.array([0.5, 0.5]), means, chols * 1.2)
+    rng = np.random.default_rng(4)
+    x = target.draw(rng, 20000)
+    logp = target.log_density(x)
+    accepted = 0
+    for _ in range(40):
+        step, log_q = component_steps(proposal, x, rng.standard_normal(x.shape), 2.0)
+        new_logp = target.log_density(x + step)
+        accept = np.log(rng.random(len(x))) < new_logp - logp + log_q
+        x[accept], logp[accept] = (x + step)[accept], new_logp[accept]
+        accepted += accept.sum()
+    assert accepted / (40 * len(x)) > 0.2
+    small = target.component_of(x) == 0
+    assert small.mean() == pytest.approx(0.3, abs=0.015)
+    np.testing.assert_allclose(x[small].std(axis=0), [0.05, 0.1], rtol=0.05)
+    np.testing.assert_allclose(x[~small].mean(axis=0), [6.0, 1.0], atol=0.06)
+    np.testing.assert_allclose(np.cov(x[~small].T), chols[1] @ chols[1].T, atol=0.12)

@@ -252,6 +252,18 @@ class GaussianMixture:
                                             + d * np.log(2.0 * np.pi)))
         return logsumexp(np.array(comps), axis=0)
 
+    def component_of(self, x: np.ndarray) -> np.ndarray:
+        """Index of the component most responsible for each row of x."""
+        x = np.atleast_2d(x)
+        comps = []
+        for w, mu, chol in zip(self.weights, self.means, self.chols):
+            z = np.linalg.solve(chol, (x - mu).T)
+            comps.append(np.log(w) - 0.5 * np.sum(z * z, axis=0)
+                         - np.sum(np.log(np.abs(np.diag(chol)))))
+        comps = np.array(comps)
+        comps[~np.isfinite(comps)] = -np.inf
+        return np.argmax(comps, axis=0)
+
     def draw(self, rng: np.random.Generator, n: int) -> np.ndarray:
         """n draws (rows)."""
         k = rng.choice(len(self.weights), size=n, p=self.weights)
@@ -332,6 +344,30 @@ def weighted_covariance(particles: np.ndarray, weights: np.ndarray) -> np.ndarra
     mean = weights @ particles
     centred = particles - mean
     return np.atleast_2d((centred * weights[:, None]).T @ centred)
+
+
+def component_steps(mixture: GaussianMixture, x: np.ndarray, z: np.ndarray, scale: float
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """Random-walk steps from rows of x, each with the covariance (times scale^2) of the
+    mixture component that x most likely belongs to, and the Hastings term
+    log q(x | x') - log q(x' | x) of each (x' = x + step: its component may differ).
+
+    One covariance for a population in several clusters (a mode's frequency in two places,
+    half the particles still at the prior while the other half sit at a MAP) is the spread
+    between the clusters, and steps that size from inside a tight cluster are nearly all
+    rejected; each cluster's own covariance keeps the moves the size of the cluster."""
+    chols = mixture.chols * scale
+    k_from = mixture.component_of(x)
+    step = np.einsum("nij,nj->ni", chols[k_from], z)
+    k_to = mixture.component_of(x + step)
+    return step, _step_log_density(chols[k_to], -step) - _step_log_density(chols[k_from], step)
+
+
+def _step_log_density(chols: np.ndarray, step: np.ndarray) -> np.ndarray:
+    """log N(step; 0, L L^T) per row, L = chols[row] (the 2 pi term left out: it cancels)."""
+    u = np.linalg.solve(chols, step[..., None])[..., 0]
+    logdet = np.sum(np.log(np.abs(np.diagonal(chols, axis1=1, axis2=2))), axis=1)
+    return -0.5 * np.sum(u * u, axis=1) - logdet
 
 
 def _variance_floor(cov: np.ndarray) -> np.ndarray:
@@ -801,16 +837,23 @@ class TMCMC(SMC_KERNEL):
         self.tempered_posterior_logp[accept] = proposal_logp[accept]
 
     def _move(self) -> int:
-        """One random-walk Metropolis move of every particle; returns how many accepted."""
+        """One random-walk Metropolis move of every particle; returns how many accepted.
+        Where the stage's mixture has several components, each particle steps with its own
+        component's covariance (:func:`component_steps`), with the Hastings correction."""
         n, d = self.tempered_posterior.shape
-        step = self.rng.standard_normal((n, d)) @ self.proposal_chol.T
+        z = self.rng.standard_normal((n, d))
+        if self.mixture is not None and len(self.mixture.weights) > 1:
+            step, log_q_ratio = component_steps(self.mixture, self.tempered_posterior, z,
+                                                self.proposal_scale / IMH_WIDEN)
+        else:
+            step, log_q_ratio = z @ self.proposal_chol.T, 0.0
         proposal = floatX(self.tempered_posterior + step)
         prior_logp, likelihood_logp = self.evaluate(proposal)
         ref_ratio = self._log_ratio(proposal)
         with np.errstate(invalid="ignore"):
             proposal_logp = self._tempered(prior_logp, likelihood_logp, ref_ratio)
             proposal_logp[np.isnan(proposal_logp)] = -np.inf
-            log_ratio = proposal_logp - self.tempered_posterior_logp
+            log_ratio = proposal_logp - self.tempered_posterior_logp + log_q_ratio
         accept = np.isfinite(proposal_logp) & (np.log(self.rng.random(n)) < log_ratio)
         self._take(accept, proposal, prior_logp, likelihood_logp, ref_ratio, proposal_logp)
         if self.mixture is not None:
