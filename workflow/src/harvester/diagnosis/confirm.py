@@ -482,7 +482,7 @@ def candidate_fit(baseline: ModelFit, effect: str, priors: Mapping[str, PriorSpe
     structure = baseline.structure.with_term(effect)
     specs = {**candidate_priors(effect, scale, baseline.problem.known), **priors}
     run = replace(settings, particles=candidate_particles(effect, settings.particles))
-    ref, where = start_of(effect, baseline, detection, specs, settings, point) \
+    ref, where = start_of(effect, baseline, detection, specs, point) \
         if settings.reference else (None, "")
     log.info("%s: %d particles per chain%s", structure.name, run.particles,
              "" if ref is None else "; half the particles start from " + where)
@@ -497,8 +497,7 @@ def candidate_fit(baseline: ModelFit, effect: str, priors: Mapping[str, PriorSpe
 
 
 def start_of(effect: str, baseline: ModelFit, detection: Detection | None,
-             specs: Mapping[str, PriorSpec], settings: ConfirmSettings, point=None
-             ) -> tuple[Reference | None, str]:
+             specs: Mapping[str, PriorSpec], point=None) -> tuple[Reference | None, str]:
     """(reference, what it is) for a candidate's TMCMC: its own MAP with the Laplace
     covariance (:func:`map_reference`) where the screen fitted it, as the baseline's starts;
     else the nested model's posterior and the detection's scan (:func:`candidate_reference`).
@@ -523,26 +522,25 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
     ``Probe.start_shape`` (:func:`candidate_reference`). ``screen``: the candidates' best
     fits (``diagnosis.screen``); then they are sampled in its order, at most ``top`` of them,
     and one whose evidence bound rules it out is not sampled (:func:`skip_reason`)."""
-    bounds = {s.effect: s for s in screen.candidates} if screen is not None else {}
+    fitted = {s.effect: s for s in screen.candidates} if screen is not None else {}
     order = screen.order if screen is not None else list(effects)
     results = []
     for i, effect in enumerate(order):
-        reason = skip_reason(bounds.get(effect), results, settings, top,
-                             baseline.log_evidence_se)
+        screened = fitted.get(effect)
+        reason = skip_reason(screened, results, settings, top, baseline.log_evidence_se)
         if reason is not None:
-            bounds[effect].skipped = reason
+            screened.skipped = reason
             log.info("%s not sampled: %s", effect, reason)
             continue
         log.info("confirming %s (%d of %d)", baseline.structure.with_term(effect).name, i + 1,
                  len(order))
-        screened = bounds.get(effect)
         point = screened.point if screened is not None and not screened.failed else None
         fit = candidate_fit(baseline, effect, priors, settings, scale, detection,
                             seed_offset + 101 * (i + 1), decisions(baseline, results, settings),
                             point)
         results.append(judge(effect, fit, baseline, settings))
-        if effect in bounds:
-            bounds[effect].sampled = True
+        if screened is not None:
+            screened.sampled = True
     results.sort(key=lambda r: -r.delta_log_evidence)
     mark_ties(results, settings)
     return results
@@ -554,9 +552,8 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     candidates were sampled already, or its evidence bound (``Screened.bound``) lies below the
     acceptance threshold (log(1/alpha) plus mc_sigmas times the root sum of squares of the
     nested model's standard error and BRIDGE_MIN_SE), or below the best accepted gain minus
-    the naming margin
-    (log(1/alpha) + mc_sigmas standard errors of that gain): it can then neither be accepted
-    nor tie with the best. None: sample it (always where it was not screened or its fit
+    the naming margin (log(1/alpha) + mc_sigmas standard errors of that gain): it can then
+    neither be accepted nor tie with the best. None: sample it (always where it was not screened or its fit
     failed)."""
     if screened is None:
         return None
