@@ -112,14 +112,14 @@ def max_loglike(problem, theta: np.ndarray) -> float:
 
 
 def _profiled(problem, theta: np.ndarray) -> tuple[float, float]:
-    """(max log L over sigma, that sigma) at the free parameters of ``theta``."""
+    """(max log L over sigma, that sigma) at the free parameters of ``theta``: one
+    simulation (``Problem.profiled_loglike``)."""
     row = np.append(np.asarray(theta, dtype=float)[:len(problem.structure.free_parameters)],
                     1.0)[None, :]
     sse, ok = problem.residual_sums(row)
     if not ok[0] or not np.isfinite(sse[0]) or sse[0] <= 0.0:
         return -np.inf, np.nan
-    row[0, -1] = np.sqrt(sse[0] / problem.n_data)
-    return float(problem.loglike(row)[0]), float(row[0, -1])
+    return float(problem.profiled_loglike(sse[0])), float(np.sqrt(sse[0] / problem.n_data))
 
 
 def fit_value(problem, theta: np.ndarray, priors: Mapping[str, PriorSpec],

@@ -176,6 +176,13 @@ class Problem:
                              self.acquisition, force_input=self.input_kind == "force",
                              v_bound=self.v_bound)
 
+    def profiled_loglike(self, sse: np.ndarray) -> np.ndarray:
+        """:meth:`loglike` with sigma at its maximum, sqrt(sse / n), from the sums of squared
+        residuals: -lambda n / 2 (log(2 pi sse / n) + 1)."""
+        n = self.n_data
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return -0.5 * self.temper * n * (np.log(2.0 * np.pi * np.asarray(sse) / n) + 1.0)
+
     def loglike(self, theta: np.ndarray) -> np.ndarray:
         """Log-likelihood, eq. (10) x ``temper``, per row of theta; -inf where simulation failed.
 

@@ -244,6 +244,16 @@ class GaussianMixture:
 
     def log_density(self, x: np.ndarray) -> np.ndarray:
         """log of the mixture's density at each row of x."""
+        return logsumexp(self._weighted_log_densities(x), axis=0)
+
+    def component_of(self, x: np.ndarray) -> np.ndarray:
+        """Index of the component most responsible for each row of x."""
+        comps = self._weighted_log_densities(x)
+        comps[~np.isfinite(comps)] = -np.inf
+        return np.argmax(comps, axis=0)
+
+    def _weighted_log_densities(self, x: np.ndarray) -> np.ndarray:
+        """log(weight x density) of each component at each row of x, (K, rows)."""
         x = np.atleast_2d(x)
         d = x.shape[1]
         comps = []
@@ -252,19 +262,7 @@ class GaussianMixture:
             logdet = 2.0 * np.sum(np.log(np.diag(chol)))
             comps.append(np.log(w) - 0.5 * (np.sum(z * z, axis=0) + logdet
                                             + d * np.log(2.0 * np.pi)))
-        return logsumexp(np.array(comps), axis=0)
-
-    def component_of(self, x: np.ndarray) -> np.ndarray:
-        """Index of the component most responsible for each row of x."""
-        x = np.atleast_2d(x)
-        comps = []
-        for w, mu, chol in zip(self.weights, self.means, self.chols):
-            z = np.linalg.solve(chol, (x - mu).T)
-            comps.append(np.log(w) - 0.5 * np.sum(z * z, axis=0)
-                         - np.sum(np.log(np.abs(np.diag(chol)))))
-        comps = np.array(comps)
-        comps[~np.isfinite(comps)] = -np.inf
-        return np.argmax(comps, axis=0)
+        return np.array(comps)
 
     def draw(self, rng: np.random.Generator, n: int) -> np.ndarray:
         """n draws (rows)."""
