@@ -7,6 +7,10 @@ per AVX2 instruction): on this project's 2-core AVX2 machine ``tanh`` takes 3.7 
 in a vectorised loop against 26 ns for the C library's (measured, ``tests/test_fastmath.py``
 checks the accuracy).
 
+Every function here is inlined into its caller in Numba's IR (``inline="always"``): LLVM
+alone kept them as calls in the larger kernels, which left those loops scalar
+(``harvester.model.codegen``).
+
 Method (Cody and Waite 1980; Tang 1989): exp(x) = 2^k exp(r) with k = round(x / ln 2) and
 r = x - k ln 2 in [-ln 2 / 2, ln 2 / 2], ln 2 split in a high and a low part so that r is exact
 to double precision; exp(r) - 1 by its Taylor series to r^13 (truncation below 1e-17 there);
@@ -59,7 +63,7 @@ def _double(typingctx, i):
     return sig, codegen
 
 
-@nb.njit(error_model="numpy", cache=True)
+@nb.njit(error_model="numpy", cache=True, inline="always")
 def _reduce(x):
     """(t, k, r): x = k ln 2 + r, k = round(x / ln 2) held in t's low bits."""
     x = min(max(x, -_X_MAX), _X_MAX)
@@ -79,7 +83,7 @@ _ATANH_SERIES = (1.0 / 23.0, 1.0 / 21.0, 1.0 / 19.0, 1.0 / 17.0, 1.0 / 15.0, 1.0
                  1.0 / 11.0, 1.0 / 9.0, 1.0 / 7.0, 1.0 / 5.0, 1.0 / 3.0, 1.0)
 
 
-@nb.njit(error_model="numpy", cache=True)
+@nb.njit(error_model="numpy", cache=True, inline="always")
 def _horner(coefficients, x):
     """The polynomial with ``coefficients`` (highest power first) at x, in Horner form."""
     p = coefficients[0]
@@ -88,19 +92,19 @@ def _horner(coefficients, x):
     return p
 
 
-@nb.njit(error_model="numpy", cache=True)
+@nb.njit(error_model="numpy", cache=True, inline="always")
 def _expm1_reduced(r):
     """exp(r) - 1 for |r| <= ln 2 / 2 (Taylor series to r^13, Horner form)."""
     return (_horner(_EXPM1_SERIES, r) * r) * r + r
 
 
-@nb.njit(error_model="numpy", cache=True)
+@nb.njit(error_model="numpy", cache=True, inline="always")
 def _two_to(t):
     """2^k for the k held in the low bits of the shifted t."""
     return _double((_bits(t) << 52) + (1023 << 52))
 
 
-@nb.njit(error_model="numpy", cache=True)
+@nb.njit(error_model="numpy", cache=True, inline="always")
 def expm1(x):
     """exp(x) - 1, accurate for small |x| too."""
     t, k, r = _reduce(x)
@@ -109,7 +113,7 @@ def expm1(x):
     return q if k == 0.0 else s * q + (s - 1.0)
 
 
-@nb.njit(error_model="numpy", cache=True)
+@nb.njit(error_model="numpy", cache=True, inline="always")
 def exp(x):
     """exp(x) (0 below -700, exp(700) above 700)."""
     t, _, r = _reduce(x)
@@ -120,7 +124,7 @@ _SQRT2 = 1.4142135623730951
 _TWO52 = 4503599627370496.0
 
 
-@nb.njit(error_model="numpy", cache=True)
+@nb.njit(error_model="numpy", cache=True, inline="always")
 def log(x):
     """ln x for x > 0 (x below 1e-300 is taken as 1e-300): x = 2^k m with m in
     [sqrt(1/2), sqrt(2)), ln m = 2 atanh(s), s = (m - 1) / (m + 1), by its odd series to s^23
@@ -138,7 +142,7 @@ def log(x):
     return k * _LN2_HI + (2.0 * s * p + k * _LN2_LO)
 
 
-@nb.njit(error_model="numpy", cache=True)
+@nb.njit(error_model="numpy", cache=True, inline="always")
 def tanh(x):
     """tanh(x) = -expm1(-2|x|) / (2 + expm1(-2|x|)), with the sign of x."""
     e = expm1(-2.0 * abs(x))
@@ -146,7 +150,7 @@ def tanh(x):
     return t if x >= 0.0 else -t
 
 
-@nb.njit(error_model="numpy", cache=True)
+@nb.njit(error_model="numpy", cache=True, inline="always")
 def sign(x):
     """-1, 0 or 1 (as a double)."""
     return (x > 0.0) - (x < 0.0) + 0.0
