@@ -19,7 +19,8 @@ laws of two terms (or one law with a ``fastmath`` exp or tanh) as calls once the
 and a loop with a call stays scalar. Measured on 31 kernels (the tanh baseline with one
 term, and with hysteresis or a mode and one more): 13 were scalar before, none after, with
 the same numbers to the bit; the LuGre record's tanh + hysteresis + mode took 9.75 ms per
-particle, 2.54 after. The price is compilation: 65 s for the 31 before, 197 s after, once per
+particle, 2.54 after. The price is compilation, nearly all of it Numba's inlining and
+typing (LLVM about 1 s of a kernel's 5-9 s): 65 s for the 31 before, 175 s after, once per
 structure (the disk cache keeps it). ``benchmarks/bench_simulator.py`` prints each kernel's speed-up from its vector lanes.
 
 ``integrate`` releases the GIL: ``harvester.model.simulate`` runs the blocks of a population
@@ -232,21 +233,23 @@ _SERVO = dict(
             "        if out_f.shape[0] > 0:\n"
             "            for c in range(C):\n"
             "                out_f[i, c] = uu[c]\n"),
-    interval="pass", slope="", inputs="", last_u="uu[c]")
+    interval="pass", slope="", inputs="")
 
 #: The base and force drivers' pieces: the input sampled, linearly interpolated in a sample.
 _SAMPLED = dict(
     head="def integrate(u, n_sub, h, P, out_acc, out_z, out_v, ok):",
     prologue="    n = u.shape[0]", sample="", interval="ui = u[i]",
-    slope="du = (u[i + 1] - ui) / n_sub",
+    slope="du = 0.0 if last else (u[i + 1] - ui) / n_sub",
     inputs=("            ua = ui + du * s\n            ub = ua + 0.5 * du\n"
-            "            uc = ua + du\n"),
-    last_u="u[n - 1]")
+            "            uc = ua + du\n"))
 
 
 def _integrate_source(terms: tuple[Term, ...], driver: str) -> str:
     """``integrate``: RK4 over a block of particles (struct of arrays), the states kept
-    finite (a particle beyond ``BLOW_UP`` is flagged and reset), z, z', z'' written out."""
+    finite (a particle beyond ``BLOW_UP`` is flagged and reset), z, z', z'' written out.
+    The last sample's z'' is the first stage of one more step, whose states are not kept:
+    the right-hand side stands in the loop once per stage and nowhere else (each copy is
+    inlined; a fifth copy for the last sample cost 11 % of the compile time)."""
     params, states = _names(terms)
     n = len(states)
     ind = " " * 16
@@ -255,8 +258,6 @@ def _integrate_source(terms: tuple[Term, ...], driver: str) -> str:
     check = " and ".join(f"abs(x{j}[c]) < BLOW_UP" for j in range(n))
     reset = "; ".join(f"x{j}[c] = 0.0" for j in range(n))
     step = "\n".join(ind + line for line in _step_source(terms, driver).splitlines())
-    out_rhs = ", ".join(f"x{j}[c]" for j in range(n)) + ", " + \
-        ", ".join(f"p_{p}[c]" for p in params)
     d = _SERVO if driver == "servo" else _SAMPLED
     return f"""{d["head"]}
     C = P.shape[1]
@@ -274,16 +275,15 @@ def _integrate_source(terms: tuple[Term, ...], driver: str) -> str:
             for c in range(C):
                 out_v[i, c] = x1[c]
         acc_row = out_acc[i] if out_acc.shape[0] > 0 else scratch
-        if i == n - 1:
-            for c in range(C):
-                acc_row[c] = rhs({d["last_u"]}, {out_rhs})[0]
-            break
+        last = i == n - 1
         {d["interval"]}
         {d["slope"]}
-        for s in range(n_sub):
+        for s in range(1 if last else n_sub):
 {d["inputs"]}            row = acc_row if s == 0 else scratch
             for c in range(C):
 {step}
+        if last:
+            break
         for c in range(C):
             if not ({check}):
                 ok[c] = False
