@@ -553,8 +553,8 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     acceptance threshold (log(1/alpha) plus mc_sigmas times the root sum of squares of the
     nested model's standard error and BRIDGE_MIN_SE), or below the best accepted gain minus
     the naming margin (log(1/alpha) + mc_sigmas standard errors of that gain): it can then
-    neither be accepted nor tie with the best. None: sample it (always where it was not screened or its fit
-    failed)."""
+    neither be accepted nor tie with the best. None: sample it (always where it was not
+    screened or its fit failed)."""
     if screened is None:
         return None
     if top is not None and len(results) >= top:

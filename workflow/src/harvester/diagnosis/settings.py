@@ -16,17 +16,18 @@ class DiagnosisSettings:
     particles, chains, seed: TMCMC; rounds: most effects added one after the other; screen:
     candidates fitted by MAP per round (the best by the detection's ranking,
     ``rank.to_confirm``), whose fits bound the evidence each can gain (``screen``); top:
-    candidates sampled per round, the best by that bound, none that it rules out; bootstrap, artifact_components, alpha, window_s: detection
-    (``DetectionSettings``); evidence_alpha: acceptance
-    (``ConfirmSettings``); unexplained_alpha: a detection that no library effect explains
-    counts as missing physics only below this p-value (an effect confirmed by evidence
-    always does; see ``decide_verdict``); lead_in_s: start of the analysis (the model starts at rest);
-    fit_seconds: most seconds of the recording TMCMC fits (None, the default: the whole window
-    the detection analyses, all but the holdout); holdout_fraction: share of the recording's end kept unseen when no validation
-    record is given; lowpass_hz: cut-off of the zero-phase low-pass the recording went
-    through (None: found from its spectrum, ``spectral.filter_cutoff``); filter_order: its
-    order; candidates: library terms considered (None: all); predictive_samples: posterior
-    samples simulated for the unseen-data comparison; figures: write figures;
+    candidates sampled per round, the best by that bound, none that it rules out; bootstrap,
+    artifact_components, alpha, window_s: detection (``DetectionSettings``); evidence_alpha:
+    acceptance (``ConfirmSettings``); unexplained_alpha: a detection that no library effect
+    explains counts as missing physics only below this p-value (an effect confirmed by
+    evidence always does; see ``decide_verdict``); lead_in_s: start of the analysis (the model
+    starts at rest); fit_seconds: most seconds of the recording TMCMC fits (None, the default:
+    the whole window the detection analyses, all but the holdout); holdout_fraction: share of
+    the recording's end kept unseen when no validation record is given; lowpass_hz: cut-off
+    of the zero-phase low-pass the recording went through (None: found from its spectrum,
+    ``spectral.filter_cutoff``); filter_order: its order; candidates: library terms
+    considered (None: all); predictive_samples: posterior samples simulated for the
+    unseen-data comparison; figures: write figures;
     reference_start: half of each model's initial particles start where other evidence puts
     them, the baseline's at its MAP and Laplace covariance (``confirm.map_reference``), a
     candidate's at the nested model's posterior and, for a start shape (a mode's frequency),

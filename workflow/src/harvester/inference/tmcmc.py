@@ -25,8 +25,8 @@ One stage of `TMCMC` (the order in which PyMC's ``sample_smc`` calls the methods
     (unconstrained) space: random-walk moves (covariance proposal_scale^2 x the stage's; where
     the mixture below has several components, each particle's own component's, with the
     Hastings term, ``component_steps``) in turn with independent moves proposed from a
-    Gaussian mixture fitted to the stage, until
-    the population has forgotten where the resampling put it: at least ``mcmc_steps`` moves, then more until the mean over
+    Gaussian mixture fitted to the stage, until the population has forgotten where the
+    resampling put it: at least ``mcmc_steps`` moves, then more until the mean over
     dimensions of |corr(start, now)| across particles falls below ``correlation_threshold``,
     at most ``max_mcmc_steps`` (PyMC's SMC kernels count their steps on the same correlation;
     Betz, Papaioannou and Straub 2016 on why TMCMC's fixed chains leave the population

@@ -21,7 +21,8 @@ term, and with hysteresis or a mode and one more): 13 were scalar before, none a
 the same numbers to the bit; the LuGre record's tanh + hysteresis + mode took 9.75 ms per
 particle, 2.54 after. The price is compilation, nearly all of it Numba's inlining and
 typing (LLVM about 1 s of a kernel's 5-9 s): 65 s for the 31 before, 175 s after, once per
-structure (the disk cache keeps it). ``benchmarks/bench_simulator.py`` prints each kernel's speed-up from its vector lanes.
+structure (the disk cache keeps it). ``benchmarks/bench_simulator.py`` prints each kernel's
+speed-up from its vector lanes.
 
 ``integrate`` releases the GIL: ``harvester.model.simulate`` runs the blocks of a population
 in a pool of threads, each block followed at once by its acquisition (compiled once for every
