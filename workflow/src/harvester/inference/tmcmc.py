@@ -87,6 +87,7 @@ from dataclasses import dataclass
 import arviz as az
 import numpy as np
 import pymc as pm
+import pytensor
 import pytensor.tensor as pt
 import xarray as xr
 from pymc.blocking import DictToArrayBijection
@@ -97,6 +98,7 @@ from pymc.pytensorf import floatX, join_nonshared_inputs, make_shared_replacemen
 from pymc.smc.kernels import SMC_KERNEL, SMCSettings, SMCStats, systematic_resampling
 from pymc.vartypes import discrete_types
 from pytensor import shared
+from pytensor.compile.mode import Mode
 from pytensor.graph.basic import Variable
 from pytensor.graph.replace import vectorize_graph
 from pytensor.graph.traversal import toposort
@@ -136,6 +138,17 @@ IMH_MIN_ACCEPT = 0.05
 #: friction's population decorrelated with its mean 17 nats below its best particle).
 FINAL_MOVES_FACTOR = 3
 SETTLE_WINDOW = 3
+#: How the graphs TMCMC needs are compiled (the population's prior and likelihood, PyMC's
+#: initial points and prior draws): with every rewrite but elementwise fusion, run by NumPy
+#: implementations, so that no C compiler runs. A cold PyTensor cache spent 18 s in gcc (27
+#: C modules) on the tanh model before its first stage; a population of 1000 particles
+#: costs the same (312 against 301 ms per call with the likelihood), because each op works
+#: on a whole column of particles. Fused ops would evaluate element by element in Python
+#: (621 ms), hence no fusion.
+COMPILE_MODE = Mode(linker="py", optimizer="fast_run").excluding("fusion")
+#: The base class compiles one-particle prior and likelihood functions that this kernel never
+#: calls (it evaluates populations, ``compile_population_logp``): compiled without rewrites.
+UNUSED_MODE = Mode(linker="py", optimizer=None)
 
 
 class TMCMCError(RuntimeError):
@@ -427,8 +440,9 @@ def compile_population_logp(model: Model, compile_kwargs: dict | None = None):
     likelihood is ``model.datalogp`` (observed variables and Potentials), as in PyMC's SMC.
     Rows are the raveled value variables in ``model.value_vars`` order (PyMC's
     ``join_nonshared_inputs``); the per-particle graph is vectorised with ``vectorize_graph``, so
-    each call evaluates every particle at once, and a `harvester.inference.batched.BatchedLogLike` in the
-    graph gets the whole matrix in one call.
+    each call evaluates every particle at once, and a `harvester.inference.batched.BatchedLogLike`
+    in the graph gets the whole matrix in one call. Compiled in ``COMPILE_MODE`` unless
+    ``compile_kwargs`` say otherwise.
     """
     value_vars = model.value_vars
     discrete = [v.name for v in value_vars if v.dtype in discrete_types]
@@ -445,7 +459,7 @@ def compile_population_logp(model: Model, compile_kwargs: dict | None = None):
     outputs = _checks_per_particle(outputs, model.check_bounds)
     particles = pt.matrix("particles", dtype=joined.dtype)
     batched = vectorize_graph(outputs, replace={joined: particles})
-    kwargs = {"on_unused_input": "ignore", **(compile_kwargs or {})}
+    kwargs = {"on_unused_input": "ignore", "mode": COMPILE_MODE, **(compile_kwargs or {})}
     with model:
         fn = pm_compile([particles], batched, **kwargs)
     fn.trust_input = True
@@ -458,8 +472,6 @@ def _reference_transforms(model: Model, names: Sequence[str], value_vars: Sequen
     The particles hold the value variables (PyMC's transformed space, e.g. log(x - lower) for
     a truncated prior); the reference's densities are in the model's own units.
     """
-    import pytensor
-
     point = model.initial_point(random_seed=0)
     offsets, start = {}, 0
     for v in value_vars:
@@ -597,7 +609,9 @@ class TMCMC(SMC_KERNEL):
                              f"{correlation_threshold}")
         if resampling not in RESAMPLING_SCHEMES:
             raise ValueError(f"resampling must be one of {RESAMPLING_SCHEMES}, got {resampling!r}")
-        super().__init__(*args, **kwargs)
+        compile_kwargs = kwargs.pop("compile_kwargs", None) or {}
+        super().__init__(*args, compile_kwargs={**compile_kwargs, "mode": UNUSED_MODE},
+                         **kwargs)
         if target_accept is not None and not 0.0 < target_accept < 1.0:
             raise ValueError(f"target_accept must be in (0, 1) or None, got {target_accept}")
         self.proposal_scale = float(proposal_scale)
@@ -613,7 +627,7 @@ class TMCMC(SMC_KERNEL):
         self.resampling = resampling
         self.log = log
         model = modelcontext(kwargs.get("model"))
-        self.population_logp_func = compile_population_logp(model, kwargs.get("compile_kwargs"))
+        self.population_logp_func = compile_population_logp(model, compile_kwargs)
         self.reference = reference
         if reference is not None:
             self._reference_columns = _reference_transforms(model, reference.names,
@@ -981,7 +995,7 @@ def run_tmcmc(
     rates, likelihood evaluations and wall times; numeric only, so it can be saved to netCDF.
     """
     start = time.perf_counter()
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), pytensor.config.change_flags(mode=COMPILE_MODE):
         # PyMC packs SMC stats as (1 chain, n chains) arrays; tidy_sample_stats redoes them.
         warnings.filterwarnings("ignore", message="More chains", category=UserWarning)
         idata = pm.sample_smc(
