@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import optimize
 
-from harvester.inference.likelihood import DAQ_OVERSAMPLE, Problem
+from harvester.inference.likelihood import DAQ_OVERSAMPLE, Problem, gaussian_loglike
 from harvester.model.simulate import Acquisition
 from harvester.inference.priors import PriorSpec
 from harvester.inference.priors import priors_for
@@ -346,7 +346,7 @@ def laplace_log_evidence(coords: PriorCoordinates, u: np.ndarray, fisher: np.nda
     d = coords.dtheta_du(u)
     log_prior = sum(float(s.logpdf(x)) for s, x in zip(coords.specs, theta)) \
         + float(np.sum(np.log(np.abs(d)))) + float(sigma_prior.logpdf(sigma))
-    log_like = -0.5 * temper * n * (np.log(2.0 * np.pi * sigma**2) + 1.0)
+    log_like = temper * gaussian_loglike(n * sigma**2, n, sigma)
     _, logdet = np.linalg.slogdet(fisher + np.eye(len(u)))
     p = len(u)
     return float(log_like + log_prior + 0.5 * (p + 1) * np.log(2.0 * np.pi) - 0.5 * logdet

@@ -26,7 +26,7 @@ from harvester.data.signals import butterworth_sos, settling_samples
 from harvester.electrical import generator as gen
 from harvester.electrical.priors import MECHANICAL, MechanicalPrior
 from harvester.electrical.records import LoadedRecord
-from harvester.inference.likelihood import DAQ_OVERSAMPLE
+from harvester.inference.likelihood import DAQ_OVERSAMPLE, gaussian_loglike
 from harvester.model.simulate import simulate
 from harvester.model.structures import Layout
 
@@ -114,11 +114,6 @@ class ElectricalProblem:
                 good &= ok
         ll[~good | ~np.isfinite(ll)] = -np.inf
         return ll
-
-
-def gaussian_loglike(sse: np.ndarray, n: int, sigma: np.ndarray) -> np.ndarray:
-    """-n/2 ln(2 pi sigma^2) - sse / (2 sigma^2), eq. (10)."""
-    return -0.5 * n * np.log(2.0 * np.pi * sigma ** 2) - 0.5 * sse / sigma ** 2
 
 
 def simulate_loaded(layout: Layout, p: dict[str, np.ndarray], known: dict[str, float],

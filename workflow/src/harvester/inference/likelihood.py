@@ -34,6 +34,12 @@ from harvester.model.structures import ModelStructure
 DAQ_OVERSAMPLE = 4
 
 
+def gaussian_loglike(sse: np.ndarray, n: int, sigma: np.ndarray) -> np.ndarray:
+    """-n/2 ln(2 pi sigma^2) - sse / (2 sigma^2), eq. (10): n independent Gaussian
+    residuals of sd sigma whose squares sum to sse."""
+    return -0.5 * n * np.log(2.0 * np.pi * sigma ** 2) - 0.5 * sse / sigma ** 2
+
+
 @dataclass
 class Problem:
     """What the sampler needs: theta = (free parameters..., sigma) -> log-likelihood.
@@ -178,10 +184,10 @@ class Problem:
 
     def profiled_loglike(self, sse: np.ndarray) -> np.ndarray:
         """:meth:`loglike` with sigma at its maximum, sqrt(sse / n), from the sums of squared
-        residuals: -lambda n / 2 (log(2 pi sse / n) + 1)."""
-        n = self.n_data
+        residuals."""
+        sse, n = np.asarray(sse, dtype=float), self.n_data
         with np.errstate(divide="ignore", invalid="ignore"):
-            return -0.5 * self.temper * n * (np.log(2.0 * np.pi * np.asarray(sse) / n) + 1.0)
+            return self.temper * gaussian_loglike(sse, n, np.sqrt(sse / n))
 
     def loglike(self, theta: np.ndarray) -> np.ndarray:
         """Log-likelihood, eq. (10) x ``temper``, per row of theta; -inf where simulation failed.
@@ -195,6 +201,6 @@ class Problem:
         sse, ok = self.residual_sums(theta)
         n = self.n_data
         with np.errstate(invalid="ignore", divide="ignore"):
-            ll = -0.5 * n * np.log(2 * np.pi * sigma**2) - 0.5 * sse / sigma**2
+            ll = gaussian_loglike(sse, n, sigma)
         ll[~(sigma > 0) | ~ok | ~np.isfinite(ll)] = -np.inf
         return self.temper * ll if self.temper != 1.0 else ll
