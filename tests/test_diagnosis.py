@@ -378,3 +378,17 @@ def test_a_candidate_is_sampled_unless_its_evidence_bound_rules_it_out():
                                                     cs, 3)
     assert skip_reason(_screened("unmodelled_mode", 398.0), best, cs, 3) is None  # may tie
     assert skip_reason(_screened("inertia_error", 398.0), best * 3, cs, 3) is not None  # top
+
+
+def test_a_trusted_importance_estimate_rules_out_what_the_bound_cannot():
+    from harvester.diagnosis.confirm import ConfirmSettings, skip_reason
+    from harvester.inference.importance import ImportanceEstimate
+    cs = ConfirmSettings()
+    mode = _screened("unmodelled_mode", 7.9)  # the bound alone would sample it
+    mode.importance = ImportanceEstimate(5817.7, 0.2, 0.3, 400.0, 1000)
+    mode.importance_gain, mode.importance_gain_se = -4.5, 0.25
+    assert skip_reason(mode, [], cs, 3) is None  # not trusted: sampled
+    mode.importance_trusted = True
+    assert "importance sampling" in skip_reason(mode, [], cs, 3)
+    mode.importance_gain = 2.0  # 2.0 + 2 x 0.25 + 1 may still pass 3.0 + margin: sampled
+    assert skip_reason(mode, [], cs, 3) is None

@@ -141,3 +141,83 @@ def test_the_diagnosis_evidence_agrees_with_tmcmc_and_is_more_precise():
     assert fit.bridge.se < 0.5
     spread = max(np.std(chains, ddof=1), 0.5)
     assert abs(fit.bridge.log_evidence - fit.tmcmc_log_evidence) < 3 * spread + 1.0
+
+
+# ---------------------------------------------------------------- importance sampling
+
+
+def _normal_prior(s0: float, d: int):
+    """A N(0, s0^2) prior per coordinate as ``MixtureProposal`` takes it."""
+    return (lambda u: stats.norm(0.0, s0).logpdf(u),
+            lambda rng, n: rng.normal(0.0, s0, (n, d)))
+
+
+def test_importance_sampling_recovers_a_conjugate_models_evidence_within_its_error():
+    from harvester.inference.importance import (Component, MixtureProposal,
+                                                importance_log_evidence)
+    z = []
+    for seed in range(20):
+        log_target, log_z, mean, cov = linear_gaussian(seed)
+        proposal = MixtureProposal(*_normal_prior(2.0, 4),
+                                   (Component((0, 1, 2, 3), mean, 1.5**2 * cov, 0.9),), 0.1)
+        est = importance_log_evidence(log_target, proposal, 1000, np.random.default_rng(seed))
+        assert est.reliable and est.se < 0.1
+        z.append((est.log_evidence - log_z) / est.se)
+    assert np.max(np.abs(z)) < 4.0
+    assert abs(np.mean(z)) < 3.0 / np.sqrt(len(z))
+
+
+def test_importance_sampling_says_when_its_proposal_misses_the_posterior():
+    from harvester.inference.importance import (Component, MixtureProposal,
+                                                importance_log_evidence)
+    log_target, log_z, mean, cov = linear_gaussian(3)
+    # a component far from the posterior: the prior's few lucky draws carry all the weight
+    proposal = MixtureProposal(*_normal_prior(2.0, 4),
+                               (Component((0, 1), -mean[:2], 0.01 * np.eye(2), 0.9),), 0.1)
+    est = importance_log_evidence(log_target, proposal, 1000, np.random.default_rng(0))
+    assert not est.reliable and est.pareto_k > 0.7
+
+
+def test_a_mixture_proposal_is_a_normalised_density_and_draws_from_it():
+    from harvester.inference.importance import Component, MixtureProposal
+    proposal = MixtureProposal(*_normal_prior(1.0, 2),
+                               (Component((0,), np.array([1.5]), np.array([[0.04]]), 0.5),
+                                Component((0, 1), np.array([-1.0, 0.5]),
+                                          np.array([[0.3, 0.1], [0.1, 0.2]]), 0.3)), 0.2)
+    grid = np.linspace(-7.0, 7.0, 561)
+    uu, vv = np.meshgrid(grid, grid, indexing="ij")
+    dens = np.exp(proposal.log_density(np.column_stack([uu.ravel(), vv.ravel()])))
+    assert integrate.trapezoid(integrate.trapezoid(dens.reshape(uu.shape), grid), grid) == \
+        pytest.approx(1.0, abs=1e-4)
+    draws = proposal.draw(np.random.default_rng(1), 40_000)
+    assert draws[:, 0].mean() == pytest.approx(0.2 * 0 + 0.5 * 1.5 + 0.3 * -1.0, abs=0.02)
+
+
+def test_the_sigma_marginal_likelihood_matches_quadrature():
+    from harvester.inference.likelihood import gaussian_loglike, sigma_marginal_loglike
+    prior = stats.truncnorm(-0.07 / 0.03, np.inf, loc=0.07, scale=0.03)
+    n, temper = 2000, 0.7
+    sse = np.array([n * 0.05**2, n * 0.09**2, np.nan])
+    got = sigma_marginal_loglike(sse, n, temper, prior.logpdf)
+    for s, g in zip(sse[:2], got[:2]):
+        peak = temper * gaussian_loglike(s, n, np.sqrt(s / n))
+        f = lambda sg: np.exp(temper * gaussian_loglike(s, n, sg) + prior.logpdf(sg) - peak)  # noqa: E731
+        hat = np.sqrt(s / n)
+        exact = np.log(integrate.quad(f, 0.8 * hat, 1.2 * hat, points=[hat])[0]) + peak
+        assert g == pytest.approx(exact, abs=1e-6)
+    assert got[2] == -np.inf
+
+
+def test_an_adapted_proposal_recovers_the_evidence_a_misplaced_one_cannot_state():
+    from harvester.inference.importance import (Component, MixtureProposal,
+                                                importance_log_evidence)
+    log_target, log_z, mean, cov = linear_gaussian(5)
+    sd = np.sqrt(np.diag(cov))
+    # narrow and off the posterior's centre: heavy-tailed weights
+    proposal = MixtureProposal(*_normal_prior(2.0, 4),
+                               (Component((0, 1, 2, 3), mean + 1.5 * sd, 0.3 * cov, 0.9),), 0.1)
+    first = importance_log_evidence(log_target, proposal, 1000, np.random.default_rng(0))
+    assert not first.reliable
+    est = importance_log_evidence(log_target, proposal, 1000, np.random.default_rng(0), adapt=2)
+    assert est.reliable
+    assert est.log_evidence == pytest.approx(log_z, abs=4.0 * est.se + 0.05)

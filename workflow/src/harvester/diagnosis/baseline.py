@@ -211,6 +211,30 @@ class PriorCoordinates:
         return np.array([th * s.scale if s.is_log else s.scale
                          for th, s in zip(theta, self.specs)])
 
+    def u_rows(self, theta: np.ndarray) -> np.ndarray:
+        """Prior coordinates of rows of parameter values."""
+        theta = np.atleast_2d(np.asarray(theta, dtype=float))
+        return np.column_stack([(s.to_coordinate(theta[:, j]) - s.center) / s.scale
+                                for j, s in enumerate(self.specs)])
+
+    def log_prior(self, u: np.ndarray) -> np.ndarray:
+        """The prior's log density in u per coordinate, (rows, parameters): log pi(theta)
+        + log |d theta / d u| (-inf outside the support)."""
+        theta = self.theta(u)
+        out = np.empty_like(theta)
+        for j, s in enumerate(self.specs):
+            with np.errstate(divide="ignore", invalid="ignore"):
+                jac = np.log(np.abs(theta[:, j]) * s.scale) if s.is_log else np.log(s.scale)
+                out[:, j] = s.logpdf(theta[:, j]) + jac
+        return np.where(np.isfinite(out), out, -np.inf)
+
+    def draw(self, rng: np.random.Generator, n: int) -> np.ndarray:
+        """n rows of u from the priors."""
+        if n == 0:
+            return np.empty((0, len(self.specs)))
+        return self.u_rows(np.column_stack([s.distribution().rvs(size=n, random_state=rng)
+                                            for s in self.specs]))
+
 
 def fit_map(problem: ChainProblem, priors: Mapping[str, PriorSpec], n_starts: int = 48,
             seed: int = 0, start: np.ndarray | None = None) -> PointFit:
@@ -342,10 +366,7 @@ def laplace_log_evidence(coords: PriorCoordinates, u: np.ndarray, fisher: np.nda
     parameter, also for a log-uniform prior, whose u spans sqrt(12) with unit variance (an
     uninformed direction then counts as the prior's width, not as infinite). Exact for a
     Gaussian posterior; on a curved or bounded one only an estimate."""
-    theta = coords.theta(u)[0]
-    d = coords.dtheta_du(u)
-    log_prior = sum(float(s.logpdf(x)) for s, x in zip(coords.specs, theta)) \
-        + float(np.sum(np.log(np.abs(d)))) + float(sigma_prior.logpdf(sigma))
+    log_prior = float(coords.log_prior(u).sum()) + float(sigma_prior.logpdf(sigma))
     log_like = temper * gaussian_loglike(n * sigma**2, n, sigma)
     _, logdet = np.linalg.slogdet(fisher + np.eye(len(u)))
     p = len(u)

@@ -549,7 +549,8 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
 def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSettings,
                 top: int | None, nested_se: float = BRIDGE_MIN_SE) -> str | None:
     """Why a screened candidate (``diagnosis.screen.Screened``) need not be sampled: ``top``
-    candidates were sampled already, or its evidence bound (``Screened.bound``) lies below the
+    candidates were sampled already, or its evidence bound (``Screened.bound``) or its
+    importance-sampling ceiling (``Screened.importance_ceiling``, where trusted) lies below the
     acceptance threshold (log(1/alpha) plus mc_sigmas times the root sum of squares of the
     nested model's standard error and BRIDGE_MIN_SE), or below the best accepted gain minus
     the naming margin (log(1/alpha) + mc_sigmas standard errors of that gain): it can then
@@ -567,6 +568,7 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
         return (f"its best fit gains at most {screened.bound:.1f} nats of evidence, below the "
                 f"acceptance threshold {least:.1f}")
     accepted = [r for r in results if r.accepted]
+    floor = -np.inf
     if accepted:
         best = max(accepted, key=lambda r: r.delta_log_evidence)
         floor = best.delta_log_evidence - settings.base_threshold \
@@ -574,6 +576,13 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
         if screened.bound < floor:
             return (f"its best fit gains at most {screened.bound:.1f} nats of evidence; "
                     f"{best.effect} gained {best.delta_log_evidence:.1f}")
+    ceiling = screened.importance_ceiling(settings.mc_sigmas)
+    if ceiling is not None and ceiling < max(least, floor):
+        return (f"importance sampling puts its evidence gain at "
+                f"{screened.importance_gain:.1f} +- {screened.importance_gain_se:.1f} nats "
+                f"(Pareto k {screened.importance.pareto_k:.2f}), at most {ceiling:.1f}, below "
+                + (f"the acceptance threshold {least:.1f}" if floor <= least else
+                   f"{best.effect}'s {best.delta_log_evidence:.1f} less the naming margin"))
     return None
 
 

@@ -200,6 +200,10 @@ def _rounds(d) -> list[dict]:
              "sampled": [r.effect for r in rnd.confirmed],
              "screened": ([s.to_dict() for s in rnd.screen.candidates]
                           if rnd.screen is not None else []),
+             "importance_check": (None if rnd.screen is None
+                                  or rnd.screen.nested_importance is None else {
+                                      **rnd.screen.nested_importance.to_dict(),
+                                      "trusted": rnd.screen.importance_check}),
              "accepted": rnd.accepted.effect if rnd.accepted else None,
              "named": bool(rnd.accepted and rnd.accepted.named),
              "device_scale": asdict(rnd.scale) if rnd.scale is not None else None}

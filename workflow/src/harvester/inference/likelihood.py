@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.signal import sosfiltfilt
+from scipy.special import logsumexp
 
 from harvester.data.recording import INPUT_KINDS, OUTPUT_KINDS
 from harvester.data.signals import butterworth_sos
@@ -38,6 +39,32 @@ def gaussian_loglike(sse: np.ndarray, n: int, sigma: np.ndarray) -> np.ndarray:
     """-n/2 ln(2 pi sigma^2) - sse / (2 sigma^2), eq. (10): n independent Gaussian
     residuals of sd sigma whose squares sum to sse."""
     return -0.5 * n * np.log(2.0 * np.pi * sigma ** 2) - 0.5 * sse / sigma ** 2
+
+
+#: Half-width of the sigma quadrature in sds of sigma's peak, and its number of nodes.
+SIGMA_SPAN, SIGMA_NODES = 12.0, 241
+
+
+def sigma_marginal_loglike(sse: np.ndarray, n: int, temper: float, log_prior) -> np.ndarray:
+    """log int L(sigma)^temper pi(sigma) d sigma, eq. (10) tempered, per sum of squares (nats).
+
+    The integrand peaks at sigma_hat = sqrt(sse / n) with relative sd 1 / sqrt(2 temper n);
+    the trapezoid rule over +-SIGMA_SPAN of those sds (``log_prior``: sigma -> log pi). NaN or
+    non-positive sums give -inf."""
+    sse = np.atleast_1d(np.asarray(sse, dtype=float))
+    ok = np.isfinite(sse) & (sse > 0)
+    out = np.full(sse.shape, -np.inf)
+    if not ok.any():
+        return out
+    hat = np.sqrt(sse[ok] / n)
+    rel = np.linspace(-SIGMA_SPAN, SIGMA_SPAN, SIGMA_NODES) / np.sqrt(2.0 * temper * n)
+    sigma = hat[:, None] * np.maximum(1.0 + rel[None, :], 1e-3)
+    with np.errstate(divide="ignore"):
+        f = temper * gaussian_loglike(sse[ok][:, None], n, sigma) + log_prior(sigma)
+    step = np.diff(sigma, axis=1)
+    pair = np.logaddexp(f[:, 1:], f[:, :-1]) + np.log(0.5 * step)
+    out[ok] = logsumexp(pair, axis=1)
+    return out
 
 
 @dataclass
