@@ -392,3 +392,16 @@ def test_a_trusted_importance_estimate_rules_out_what_the_bound_cannot():
     assert "importance sampling" in skip_reason(mode, [], cs, 3)
     mode.importance_gain = 2.0  # 2.0 + 2 x 0.25 + 1 may still pass 3.0 + margin: sampled
     assert skip_reason(mode, [], cs, 3) is None
+
+
+def test_a_failed_fit_is_ruled_out_only_by_a_trusted_importance_estimate():
+    from harvester.diagnosis.confirm import ConfirmSettings, skip_reason
+    from harvester.inference.importance import ImportanceEstimate
+    cs = ConfirmSettings()
+    stop = _screened("backlash", -300.0, failed=True)  # its bound means nothing
+    assert skip_reason(stop, [], cs, 3) is None
+    stop.importance = ImportanceEstimate(4035.0, 0.3, 0.5, 200.0, 1000)
+    stop.importance_gain, stop.importance_gain_se = -360.0, 0.3
+    assert skip_reason(stop, [], cs, 3) is None  # not trusted: sampled
+    stop.importance_trusted = True
+    assert "fell below the nested model's" in skip_reason(stop, [], cs, 3)

@@ -554,16 +554,25 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     acceptance threshold (log(1/alpha) plus mc_sigmas times the root sum of squares of the
     nested model's standard error and BRIDGE_MIN_SE), or below the best accepted gain minus
     the naming margin (log(1/alpha) + mc_sigmas standard errors of that gain): it can then
-    neither be accepted nor tie with the best. None: sample it (always where it was not
-    screened or its fit failed)."""
+    neither be accepted nor tie with the best. A candidate whose fit failed (fell below the
+    nested model's: an optimiser that missed, or an effect whose smallest admissible size
+    already costs) is ruled out by a trusted importance-sampling estimate alone, which does
+    not rest on the fit. None: sample it (always where it was not screened)."""
     if screened is None:
         return None
     if top is not None and len(results) >= top:
         return f"the round's {top} best by their fits were sampled"
-    if screened.failed:
-        return None
     least = settings.base_threshold + settings.mc_sigmas * float(np.hypot(nested_se,
                                                                           BRIDGE_MIN_SE))
+    if screened.failed:  # its bound means nothing; a trusted estimate still does
+        ceiling = screened.importance_ceiling(settings.mc_sigmas)
+        if ceiling is not None and ceiling < least:
+            return (f"its fit fell below the nested model's, and importance sampling puts its "
+                    f"evidence gain at {screened.importance_gain:.1f} +- "
+                    f"{screened.importance_gain_se:.1f} nats (Pareto k "
+                    f"{screened.importance.pareto_k:.2f}), at most {ceiling:.1f}, below the "
+                    f"acceptance threshold {least:.1f}")
+        return None
     if screened.bound < least:
         return (f"its best fit gains at most {screened.bound:.1f} nats of evidence, below the "
                 f"acceptance threshold {least:.1f}")

@@ -26,8 +26,9 @@ whose bound lies below the best accepted gain minus the naming margin cannot tie
 (``confirm.skip_reason``): neither needs TMCMC. The bound misleads where the MAP misses the
 best fit: the fit starts from the best of the nested posterior's mean joined with prior draws
 of the added parameters and, for a start shape (a mode's frequency), the detection's scan; a
-fit below the nested model's best (impossible at the optimum of a model that
-contains the nested one) is marked ``failed`` and never screened out. Each candidate's
+fit below the nested model's best (impossible at the optimum of a model that contains the
+nested one; possible where the added term's smallest admissible size already costs, as for a
+log-uniform amplitude) is marked ``failed``, and its bound is not used. Each candidate's
 Laplace log evidence (``baseline.laplace_log_evidence``) minus the nested model's is reported
 beside it.
 
@@ -321,8 +322,7 @@ def _screen_one(nested: ModelFit, effect: str, priors: Mapping[str, PriorSpec],
             out.importance = est
             out.importance_gain = est.log_evidence - nested.log_evidence
             out.importance_gain_se = float(np.hypot(est.se, nested.log_evidence_se))
-            out.importance_trusted = bool(so_far.importance_check and est.reliable
-                                          and not out.failed)
+            out.importance_trusted = bool(so_far.importance_check and est.reliable)
         out.seconds += time.perf_counter() - clock
         log.info("%s: importance sampling %s (%.1f s)", effect, _describe(out),
                  time.perf_counter() - clock)
