@@ -567,11 +567,8 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     if screened.failed:  # its bound means nothing; a trusted estimate still does
         ceiling = screened.importance_ceiling(settings.mc_sigmas)
         if ceiling is not None and ceiling < least:
-            return (f"its fit fell below the nested model's, and importance sampling puts its "
-                    f"evidence gain at {screened.importance_gain:.1f} +- "
-                    f"{screened.importance_gain_se:.1f} nats (Pareto k "
-                    f"{screened.importance.pareto_k:.2f}), at most {ceiling:.1f}, below the "
-                    f"acceptance threshold {least:.1f}")
+            return (f"its fit fell below the nested model's; {screened.importance_phrase()}, "
+                    f"at most {ceiling:.1f}, below the acceptance threshold {least:.1f}")
         return None
     if screened.bound < least:
         return (f"its best fit gains at most {screened.bound:.1f} nats of evidence, below the "
@@ -587,9 +584,7 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
                     f"{best.effect} gained {best.delta_log_evidence:.1f}")
     ceiling = screened.importance_ceiling(settings.mc_sigmas)
     if ceiling is not None and ceiling < max(least, floor):
-        return (f"importance sampling puts its evidence gain at "
-                f"{screened.importance_gain:.1f} +- {screened.importance_gain_se:.1f} nats "
-                f"(Pareto k {screened.importance.pareto_k:.2f}), at most {ceiling:.1f}, below "
+        return (f"{screened.importance_phrase()}, at most {ceiling:.1f}, below "
                 + (f"the acceptance threshold {least:.1f}" if floor <= least else
                    f"{best.effect}'s {best.delta_log_evidence:.1f} less the naming margin"))
     return None

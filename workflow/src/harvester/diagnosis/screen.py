@@ -125,6 +125,15 @@ class Screened:
             return None
         return self.importance_gain + mc_sigmas * self.importance_gain_se + IMPORTANCE_SLACK
 
+    def importance_phrase(self) -> str:
+        """The estimate in words, for logs and the reasons a candidate was not sampled."""
+        if self.importance is None:
+            return "no importance-sampling estimate (no prior of sigma)"
+        est = self.importance
+        return (f"importance sampling puts its evidence gain at {self.importance_gain:.2f} +- "
+                f"{self.importance_gain_se:.2f} nats (Pareto k {est.pareto_k:.2f}, ESS "
+                f"{est.ess:.0f} of {est.draws}{'' if self.importance_trusted else ', not trusted'})")
+
     def to_dict(self) -> dict:
         added = term(self.effect).parameter_names
         return {"effect": self.effect, "max_log_likelihood": self.max_loglike,
@@ -226,14 +235,6 @@ def check_estimator(out: Screen, nested: ModelFit, point: PointFit, seed: int) -
              "trusted this round" if out.importance_check else "not trusted this round")
 
 
-def _describe(s: Screened) -> str:
-    if s.importance is None:
-        return "not made (no prior of sigma)"
-    return (f"gain {s.importance_gain:+.2f} +- {s.importance_gain_se:.2f} (Pareto k "
-            f"{s.importance.pareto_k:.2f}, ESS {s.importance.ess:.0f} of "
-            f"{s.importance.draws}){'' if s.importance_trusted else ', not trusted'}")
-
-
 def importance_evidence(problem, specs: Mapping[str, PriorSpec], point: PointFit,
                         nested: ModelFit, seed: int) -> ImportanceEstimate | None:
     """log evidence of ``problem`` (tempered eq. (10), sigma integrated out) by importance
@@ -324,7 +325,7 @@ def _screen_one(nested: ModelFit, effect: str, priors: Mapping[str, PriorSpec],
             out.importance_gain_se = float(np.hypot(est.se, nested.log_evidence_se))
             out.importance_trusted = bool(so_far.importance_check and est.reliable)
         out.seconds += time.perf_counter() - clock
-        log.info("%s: importance sampling %s (%.1f s)", effect, _describe(out),
+        log.info("%s: %s (%.1f s)", effect, out.importance_phrase(),
                  time.perf_counter() - clock)
 
     out.pending = estimate

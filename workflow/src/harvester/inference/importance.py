@@ -24,9 +24,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
+import arviz as az
 import numpy as np
 from scipy import stats
 from scipy.special import logsumexp
+
+from harvester.inference.tmcmc import fit_gaussian_mixture
 
 __all__ = ["Component", "ImportanceEstimate", "MixtureProposal", "importance_estimate",
            "importance_log_evidence"]
@@ -135,8 +138,6 @@ def importance_estimate(log_w: np.ndarray) -> ImportanceEstimate:
 def pareto_k(log_w: np.ndarray) -> float:
     """Shape k of the generalised Pareto distribution fitted to the largest weights
     (ArviZ's PSIS); zero-weight draws enter as far below the smallest finite one."""
-    import arviz as az
-
     log_w = np.asarray(log_w, dtype=float)
     finite = np.isfinite(log_w)
     floor = log_w[finite].min() - 50.0
@@ -182,10 +183,6 @@ def adapted(proposal: MixtureProposal, u: np.ndarray, log_w: np.ndarray,
     Pareto-smoothed so that a few large ones do not shrink it to a point
     (``tmcmc.fit_gaussian_mixture``, sds widened by ADAPT_WIDEN), which takes ADAPT_SHARE
     of the weight that is not the prior's."""
-    from harvester.inference.tmcmc import fit_gaussian_mixture
-
-    import arviz as az
-
     keep = np.isfinite(log_w)
     smoothed, _ = az.psislw(log_w[keep])
     w = np.exp(smoothed - smoothed.max())
