@@ -221,3 +221,13 @@ def test_an_adapted_proposal_recovers_the_evidence_a_misplaced_one_cannot_state(
     est = importance_log_evidence(log_target, proposal, 1000, np.random.default_rng(0), adapt=2)
     assert est.reliable
     assert est.log_evidence == pytest.approx(log_z, abs=4.0 * est.se + 0.05)
+
+
+def test_a_component_with_a_covariance_that_is_not_positive_definite_still_draws():
+    # a Laplace covariance from a Hessian that is not positive definite at a fit's end
+    from harvester.inference.importance import Component
+
+    comp = Component((0, 1), np.zeros(2), np.array([[1.0, 1.2], [1.2, 1.0]]), 0.5)
+    dist = comp.distribution()
+    draws = dist.rvs(size=200, random_state=np.random.default_rng(0))
+    assert np.isfinite(dist.logpdf(draws)).all()

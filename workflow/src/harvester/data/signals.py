@@ -193,6 +193,16 @@ ANTIALIAS_ORDER = 8
 ANTIALIAS_FRACTION = 0.8
 
 
+def chain_cutoff(fs: float, lowpass_hz: float | None = None) -> float:
+    """Cut-off (Hz) of the measurement chain a recording sampled at ``fs`` (Hz) went through:
+    its low-pass ``lowpass_hz``, or without one the model's own DAQ anti-alias edge
+    (ANTIALIAS_FRACTION x Nyquist). Above that edge the model's acquisition and the
+    recording's unknown anti-alias filter differ (a flat FIR keeps at 105 Hz of a 256 Hz record
+    what the model's Butterworth cuts to 0.14), so the residual there is the two filters'
+    difference, not physics."""
+    return float(lowpass_hz) if lowpass_hz else ANTIALIAS_FRACTION * 0.5 * float(fs)
+
+
 def antialias_decimate(x: ArrayLike, fs: float, q: int) -> NDArray[np.float64]:
     """Every q-th sample along the last axis after the anti-alias low-pass (ANTIALIAS_*), as a
     data acquisition samples a faster signal."""

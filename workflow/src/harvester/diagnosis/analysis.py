@@ -20,10 +20,11 @@ import pandas as pd
 
 from harvester.data.daq import RECORDING_COLUMNS
 from harvester.data.errors import DataError
+from harvester.data.input_noise import NoiseFloor, noise_floor, wiener_input
 from harvester.data.signals import resample_recording, resampling_ratio, uniform_step
 from harvester.diagnosis.baseline import ChainProblem, baseline_state, chain_problem, fit_map
 from harvester.diagnosis.confirm import ModelFit, fit_structure, map_reference
-from harvester.diagnosis.detect import estimate_temper
+from harvester.diagnosis.detect import band_top, estimate_temper
 from harvester.diagnosis.settings import DiagnosisSettings
 from harvester.diagnosis.spectral import filter_cutoff
 from harvester.inference.problems import make_problem
@@ -106,6 +107,7 @@ class Analysis:
     detection_raw: Problem
     fit_raw: Problem
     notes: list[str] = field(default_factory=list)
+    input_floor: NoiseFloor | None = None  # the base channel's noise floor, where it shows one
 
     @property
     def time(self) -> np.ndarray:
@@ -118,7 +120,7 @@ class Analysis:
     @property
     def f_high(self) -> float:
         """Upper edge of the band the diagnosis analyses (Hz)."""
-        return 0.9 * (self.lowpass or 0.5 * self.fs)
+        return band_top(self.fs, self.lowpass)
 
     @property
     def window(self) -> tuple[int, int]:
@@ -145,6 +147,9 @@ def prepare(recording: pd.DataFrame, validation: pd.DataFrame | None,
     lowpass = settings.lowpass_hz or filter_cutoff(rec["rel_acc"].to_numpy(), 1.0 / dt)
     rec, validation, dt, notes = resample_for_model(rec, validation, dt, lowpass)
     fs, n = 1.0 / dt, len(rec)
+    floor = None
+    if settings.denoise_input:
+        rec, validation, floor = model_input(rec, validation, fs, band_top(fs, lowpass), notes)
     lead = int(round(settings.lead_in_s * fs))
     # the analysis stops half a second before the record's end (the zero-phase filters'
     # end effects) or where the held-out tail starts
@@ -155,7 +160,7 @@ def prepare(recording: pd.DataFrame, validation: pd.DataFrame | None,
         min(hold, lead + int(round(settings.fit_seconds * fs)))
     out = Analysis(rec, validation, base, dict(known), dt, lowpass, settings.filter_order,
                    lead, hold, fit_stop, end, make_problem(rec, base, known, window=(lead, hold)),
-                   make_problem(rec, base, known, window=(lead, fit_stop)), notes)
+                   make_problem(rec, base, known, window=(lead, fit_stop)), notes, floor)
     t = out.time
     log.info("recording %s: %.1f s at %.0f Hz; low-pass %s; analysed %.1f-%.1f s, TMCMC on "
              "%.1f-%.1f s", source, n * dt, fs,
@@ -164,6 +169,28 @@ def prepare(recording: pd.DataFrame, validation: pd.DataFrame | None,
     for line in settings.trades():
         log.warning("these settings trade away: %s", line)
     return out
+
+
+def model_input(rec: pd.DataFrame, validation: pd.DataFrame | None, fs: float, f_high: float,
+                notes: list[str]) -> tuple[pd.DataFrame, pd.DataFrame | None, NoiseFloor | None]:
+    """The recordings with the base acceleration the models are driven by: its Wiener
+    estimate where the channel shows a noise floor below ``f_high`` Hz
+    (:mod:`harvester.data.input_noise`; the validation record with the training record's
+    floor), else as recorded. Copies; the recordings passed in are not changed."""
+    floor = noise_floor(rec["base_acc"].to_numpy(), fs, f_high)
+    if floor is None:
+        return rec, validation, None
+    out = [r if r is None else r.assign(base_acc=wiener_input(r["base_acc"].to_numpy(), fs,
+                                                                floor))
+           for r in (rec, validation)]
+    line = (f"base_acc shows a white noise floor of {floor.rms:.3g} RMS over "
+            f"{floor.band_hz[0]:.2g}-{floor.band_hz[1]:.3g} Hz ({floor.share:.0%} of the band, "
+            f"{floor.dynamic_range:.3g} x below its strongest line): the models are driven by "
+            "its Wiener estimate, so that the input's noise does not reach the residual "
+            "through them")
+    log.info("%s", line)
+    notes.append(line)
+    return out[0], out[1], floor
 
 
 def default_priors(structure: ModelStructure, sigma: float) -> dict[str, PriorSpec]:

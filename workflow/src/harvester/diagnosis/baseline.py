@@ -20,6 +20,8 @@ cut-off lies below the recording's (``ANALYSIS_FRACTION``): in the recording fil
 transition band the data have been filtered twice (once by the rig, once here) and the model
 once, and no model of the chain removes that for every input (the simulated response to the
 low-passed input already carries the filter's linear part; its friction harmonics do not).
+A recording that went through no low-pass still went through its DAQ's anti-alias filter,
+whose edge the model's acquisition places at its own (``signals.chain_cutoff``).
 """
 
 from __future__ import annotations
@@ -35,7 +37,7 @@ from harvester.inference.likelihood import DAQ_OVERSAMPLE, Problem, gaussian_log
 from harvester.model.simulate import Acquisition
 from harvester.inference.priors import PriorSpec
 from harvester.inference.priors import priors_for
-from harvester.data.signals import lowpass
+from harvester.data.signals import chain_cutoff, lowpass
 
 log = logging.getLogger("harvester.diagnosis")
 
@@ -53,12 +55,13 @@ class ChainProblem(Problem):
     """:class:`~harvester.inference.likelihood.Problem` with the measurement chain and a tempered eq. (10).
 
     The recordings went through a zero-phase low-pass (``lowpass_hz``, ``filter_order``;
-    None: none); the simulated z'' did not, and its content above the cut-off (friction
-    harmonics) has no counterpart in the data. So both the simulated and the measured z'' go
-    through a zero-phase Butterworth low-pass of that order at ``band_fraction`` x
-    ``lowpass_hz`` (``chain``) before the residual is formed, and the log-likelihood of eq.
-    (10) is multiplied by ``temper`` = lambda. With ``lowpass_hz=None, temper=1`` it is the
-    study's likelihood unchanged.
+    None: only their DAQ's anti-alias filter); the simulated z'' did not, and its content
+    above the cut-off (friction harmonics) has no counterpart in the data. So both the
+    simulated and the measured z'' go through a zero-phase Butterworth low-pass of that order
+    at ``band_fraction`` x the chain's cut-off (``chain``; the cut-off is ``lowpass_hz``, or
+    without one the model DAQ's anti-alias edge, :func:`~harvester.data.signals.chain_cutoff`)
+    before the residual is formed, and the log-likelihood of eq. (10) is multiplied by
+    ``temper`` = lambda.
     """
 
     temper: float = 1.0
@@ -68,12 +71,13 @@ class ChainProblem(Problem):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        self._observed_chain = self.chain(self.rel_acc)[self.samples]
+        self._observed_chain = self.measured_chain[self.samples]
 
     @property
-    def band_hz(self) -> float | None:
-        """Cut-off of the likelihood's low-pass (Hz), None without a recording filter."""
-        return None if self.lowpass_hz is None else self.band_fraction * self.lowpass_hz
+    def band_hz(self) -> float:
+        """Cut-off of the likelihood's low-pass (Hz): ``band_fraction`` x the measurement
+        chain's cut-off (:func:`~harvester.data.signals.chain_cutoff`)."""
+        return self.band_fraction * chain_cutoff(1.0 / self.dt, self.lowpass_hz)
 
     def _lowpass(self, x: np.ndarray, cutoff: float | None) -> np.ndarray:
         if cutoff is None:
@@ -81,8 +85,14 @@ class ChainProblem(Problem):
         return lowpass(x, 1.0 / self.dt, cutoff, self.filter_order)
 
     def chain(self, x: np.ndarray) -> np.ndarray:
-        """The likelihood's low-pass (``band_hz``) along the last axis (identity if None)."""
+        """The likelihood's low-pass (``band_hz``) along the last axis."""
         return self._lowpass(x, self.band_hz)
+
+    @property
+    def measured_chain(self) -> np.ndarray:
+        """The measured z'' over the whole record as the residual takes it: through the
+        acquisition's filter (:attr:`acquired_output`) and the chain."""
+        return self.chain(self.acquired_output)
 
     def recording_filter(self, x: np.ndarray) -> np.ndarray:
         """The recording's own low-pass (``lowpass_hz``) along the last axis."""
@@ -108,8 +118,7 @@ class ChainProblem(Problem):
     @property
     def acquisition(self) -> Acquisition:
         """The DAQ's oversampling and the likelihood's low-pass (``band_hz``)."""
-        band = self.band_hz
-        return Acquisition(self.oversample, None if band is None else (band, self.filter_order))
+        return Acquisition(self.oversample, (self.band_hz, self.filter_order))
 
 
 #: Samples simulated beyond the window's end so that the zero-phase filter's end effect
@@ -347,7 +356,7 @@ def _point_fit(problem: ChainProblem, coords: PriorCoordinates, u: np.ndarray, r
              ", ".join(f"{nm}={v:.4g}" for nm, v in zip(problem.structure.free_parameters,
                                                         theta_phys)), sigma, count[0])
     pred, _ = problem.predicted(np.append(theta_phys, sigma))
-    residual = problem.chain(problem.rel_acc) - pred[0]
+    residual = problem.measured_chain - pred[0]
     evidence = float("nan") if sigma_prior is None else laplace_log_evidence(
         coords, u, temper * jm.T @ jm / sigma**2, sigma, temper, n, sigma_prior)
     return PointFit(np.append(theta_phys, sigma), cov, residual, problem.parameter_names,
@@ -434,4 +443,4 @@ def baseline_state(problem: ChainProblem, samples: np.ndarray) -> BaselineState:
     model = problem.chain(sim.rel_acc[0])
     jac = sensitivities(problem, theta, sd)
     return BaselineState(problem, theta, sd, samples, sim.rel_disp[0], sim.rel_vel[0],
-                         model, problem.chain(problem.rel_acc) - model, jac)
+                         model, problem.measured_chain - model, jac)

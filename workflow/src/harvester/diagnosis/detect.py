@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from harvester.data.signals import chain_cutoff
 from harvester.diagnosis.baseline import BaselineState
 from harvester.diagnosis.locate import (FrequencyBands, MeasuredStandstill, Standardised,
                                         StateRegions, TimeWindows, standardise)
@@ -51,6 +52,17 @@ log = logging.getLogger("harvester.diagnosis")
 
 
 
+#: The analysed band ends at this fraction of the measurement chain's cut-off.
+BAND_FRACTION = 0.9
+
+
+def band_top(fs: float, lowpass_hz: float | None, fraction: float = BAND_FRACTION) -> float:
+    """Upper edge (Hz) of the band the detection analyses: ``fraction`` x the cut-off of the
+    measurement chain (the recording's low-pass, or the DAQ's anti-alias edge without one:
+    :func:`~harvester.data.signals.chain_cutoff`)."""
+    return fraction * chain_cutoff(fs, lowpass_hz)
+
+
 @dataclass(frozen=True)
 class DetectionSettings:
     """Calibration and location settings.
@@ -58,7 +70,7 @@ class DetectionSettings:
     bootstrap: noise replicates; artifact_components: re-simulations of the baseline that
     reproduce what the preprocessing low-pass does to a nonlinear structure (0: none), cycled
     over the replicates; alpha: false-alarm rate of the verdict; band_fraction: the
-    analysed band ends at this fraction of the measurement chain's cut-off (Nyquist without);
+    analysed band ends at this fraction of the measurement chain's cut-off (:func:`band_top`);
     gross_region_ratio, gross_window_ratio: a region (window) counts towards the verdict only
     when it holds at least this many times its share of time (expected share) of the residual
     energy, besides being significant (see :func:`detect`); window_s: length of
@@ -69,7 +81,7 @@ class DetectionSettings:
     bootstrap: int = 400
     artifact_components: int = 60
     alpha: float = 0.05
-    band_fraction: float = 0.9
+    band_fraction: float = BAND_FRACTION
     gross_region_ratio: float = 1.5
     gross_window_ratio: float = 2.0
     window_s: float = 1.0
@@ -533,12 +545,12 @@ def detect(state: BaselineState, window: tuple[int, int], priors: Mapping[str, P
     """Calibrated detection and location of a mismatch of the baseline over ``window``.
 
     The analysed band ends at ``settings.band_fraction`` x the measurement chain's cut-off
-    (the problem's ``lowpass_hz``; Nyquist when there is none).
+    (:func:`band_top`).
     """
     problem = state.problem
     if window[1] > len(state.residual):
         raise ValueError(f"window {window} beyond the problem's record ({len(state.residual)})")
-    f_high = settings.band_fraction * (problem.lowpass_hz or 0.5 / problem.dt)
+    f_high = band_top(1.0 / problem.dt, problem.lowpass_hz, settings.band_fraction)
     time = np.arange(len(problem.rel_acc)) * problem.dt if time is None else time
     w = whiten(state, window, f_high)
     sigs = signature_set(state, w, window, f_high, candidates)

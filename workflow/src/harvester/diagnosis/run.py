@@ -22,11 +22,12 @@ import pandas as pd
 
 from harvester.data.signals import uniform_step
 from harvester.diagnosis.analysis import (Analysis, BaselineStart, check_recording,
-                                          default_priors, prepare, resample_for_model,
+                                          default_priors, model_input, prepare,
+                                          resample_for_model,
                                           start_baseline, velocity_bound)
 from harvester.diagnosis.baseline import BaselineState, baseline_state, chain_problem, fit_map
 from harvester.diagnosis.confirm import ModelFit
-from harvester.diagnosis.detect import Detection, detect, estimate_temper
+from harvester.diagnosis.detect import Detection, band_top, detect, estimate_temper
 from harvester.diagnosis.report import UnseenFit, unseen_fit
 from harvester.diagnosis.rounds import Round, run_rounds
 from harvester.diagnosis.settings import DiagnosisSettings
@@ -177,12 +178,14 @@ def quick_detect(recording: pd.DataFrame, baseline: str | ModelStructure,
     lowpass = settings.lowpass_hz or filter_cutoff(rec["rel_acc"].to_numpy(), 1.0 / dt)
     rec, _, dt, _ = resample_for_model(rec, None, dt, lowpass)
     fs = 1.0 / dt
+    if settings.denoise_input:
+        rec, _, _ = model_input(rec, None, fs, band_top(fs, lowpass), [])
     lead = int(round(settings.lead_in_s * fs))
     raw = make_problem(rec, base, known, window=(lead, len(rec)))
     if temper is None:
         mp = fit_map(chain_problem(raw, 1.0, lowpass, settings.filter_order), priors or {},
                      seed=settings.seed)
-        temper = estimate_temper(mp.residual, raw.window, fs, 0.9 * (lowpass or 0.5 * fs))
+        temper = estimate_temper(mp.residual, raw.window, fs, band_top(fs, lowpass))
     problem = chain_problem(raw, temper, lowpass, settings.filter_order)
     mp = fit_map(problem, priors or {}, seed=settings.seed)
     specs = {**default_priors(base, float(mp.theta[-1])), **(priors or {})}

@@ -34,7 +34,9 @@ class DiagnosisSettings:
     the detection's scan (``confirm.candidate_reference``); the tempering path changes, not
     the posterior or the evidence. False: every model from its prior. enlargements: how often
     a model whose two chains disagree by more than a nat is sampled again with twice the
-    particles.
+    particles. denoise_input: drive the models with the Wiener estimate of the base
+    acceleration where its channel shows a noise floor (``data.input_noise``); False: as
+    recorded.
     """
 
     particles: int = 300
@@ -59,6 +61,7 @@ class DiagnosisSettings:
     enlargements: int = 2
     figures: bool = True
     reference_start: bool = True
+    denoise_input: bool = True
 
     @classmethod
     def fast(cls, **overrides) -> "DiagnosisSettings":

@@ -49,9 +49,14 @@ class Component:
     weight: float
 
     def distribution(self):
+        """The normal, its covariance made positive definite: symmetrised, and eigenvalues
+        below 1e-9 x the largest raised to that (a Laplace covariance from a Hessian that
+        is not positive definite at a MAP fit's end has some below zero)."""
         cov = np.atleast_2d(np.asarray(self.cov, dtype=float))
-        cov = 0.5 * (cov + cov.T) + np.diag(np.maximum(np.diag(cov), 1e-300) * 1e-9)
-        return stats.multivariate_normal(np.asarray(self.mean, dtype=float), cov)
+        vals, vecs = np.linalg.eigh(0.5 * (cov + cov.T))
+        vals = np.maximum(vals, 1e-9 * max(float(vals.max()), 1e-300))
+        return stats.multivariate_normal(np.asarray(self.mean, dtype=float),
+                                         (vecs * vals) @ vecs.T)
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,8 @@ from scipy.special import logsumexp
 
 from harvester.data.recording import INPUT_KINDS, OUTPUT_KINDS
 from harvester.data.signals import butterworth_sos
-from harvester.model.simulate import Acquisition, Simulation, residual_sums, simulate
+from harvester.model.simulate import (Acquisition, Simulation, acquired, residual_sums,
+                                      simulate)
 from harvester.model.structures import ModelStructure
 
 
@@ -91,6 +92,7 @@ class Problem:
     v_bound: float | None = None  # largest velocity (m/s) for the sub-step choice (simulate)
     oversample: int = 1  # simulate at this x the rate and anti-alias z'' (simulate, a DAQ's view)
     n_evaluations: int = field(default=0, init=False)
+    _acquired: np.ndarray | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         self.input = np.asarray(self.input, dtype=float)
@@ -153,8 +155,18 @@ class Problem:
         return len(range(*self.samples.indices(len(self.output))))
 
     @property
+    def acquired_output(self) -> np.ndarray:
+        """The measured output record through the acquisition's filter (``oversample``;
+        :func:`harvester.model.simulate.acquired`), as the simulated output is sampled."""
+        if self._acquired is None:
+            self._acquired = acquired(self.output, self.dt, self.oversample)
+        return self._acquired
+
+    @property
     def observed(self) -> np.ndarray:
-        return self.output[self.samples]
+        """What the likelihood compares the simulated output with: the samples it uses of
+        :attr:`acquired_output`."""
+        return self.acquired_output[self.samples]
 
     # ---- model --------------------------------------------------------------------------------
 

@@ -36,7 +36,8 @@ import numba as nb
 import numpy as np
 from scipy import signal
 
-from harvester.data.signals import ANTIALIAS_FRACTION, ANTIALIAS_ORDER, butterworth_sos
+from harvester.data.signals import (ANTIALIAS_FRACTION, ANTIALIAS_ORDER,
+                                    antialias_decimate, butterworth_sos)
 from harvester.model import acquisition, codegen
 from harvester.model.structures import Layout
 from harvester.model.terms import step_rates
@@ -201,8 +202,31 @@ def _prepare(layout: Layout, params: np.ndarray, u: np.ndarray, dt: float,
         coarse = np.broadcast_to(np.asarray(n_substeps, dtype=np.int64), (p.shape[0],))
         fine = np.maximum(1, -(-coarse // q)) if q > 1 else coarse.copy()
     if q > 1:
-        u = np.ascontiguousarray(signal.resample_poly(u, q, 1)[: u.size * q])
+        u = np.ascontiguousarray(_interpolate(u, q))
     return p, valid, u, dt / q, fine.astype(np.int64), Blocks.of(fine)
+
+
+def _interpolate(x: np.ndarray, q: int) -> np.ndarray:
+    """The input at q x its rate, band-limited (the acquisition's first step), last axis."""
+    return signal.resample_poly(x, q, 1, axis=-1)[..., : x.shape[-1] * q]
+
+
+def acquired(x: np.ndarray, dt: float, oversample: int) -> np.ndarray:
+    """A record sampled every ``dt`` s through the filter the acquisition (``oversample`` q,
+    module docstring) puts on the simulated output's in-band content: the band-limited
+    interpolation to q x the rate, the anti-alias low-pass and every q-th sample.
+
+    A recorded output went through its own DAQ only. Passed through this it meets the
+    simulated one on equal terms: the linear response of a device to the recorded input then
+    carries the same filter on both sides (measured on a linear device at 256 Hz: without
+    it the simulated z'' is 0.985 of the recorded at 80 Hz and 0.60 at 100 Hz). Below 0.6 x
+    the anti-alias edge it changes a record by less than 1e-3.
+    """
+    x = np.asarray(x, dtype=float)
+    q = int(oversample)
+    if q == 1:
+        return x.copy()
+    return antialias_decimate(_interpolate(x, q), q / dt, q)
 
 
 def _base_block(integrate, u, P, order, a, b, n_sub, h, q, aa, aa_pad, out_filt, out_pad,

@@ -1,0 +1,56 @@
+"""The input channel's noise floor and the input without its noise-only bins."""
+
+import numpy as np
+import pytest
+
+from harvester.data.input_noise import NoiseFloor, input_gain, noise_floor, wiener_input
+from harvester.data.signals import psd
+
+FS = 256.0
+N = int(40 * FS)
+
+
+def _multisine(rng, f_lo, f_hi, lines=60, peak=2.0):
+    t = np.arange(N) / FS
+    freqs = np.linspace(f_lo, f_hi, lines)
+    x = np.sum(np.sin(2 * np.pi * freqs[:, None] * t + rng.uniform(0, 2 * np.pi, (lines, 1))),
+               axis=0)
+    return peak * x / np.abs(x).max()
+
+
+def test_the_floor_of_a_narrow_excitation_is_its_sensor_noise():
+    rng = np.random.default_rng(0)
+    noise = 0.06 * rng.standard_normal(N)            # white: N0 = 0.06^2 / (FS / 2)
+    floor = noise_floor(_multisine(rng, 0.4, 3.0) + noise, FS, 92.0)
+    assert floor is not None
+    assert floor.level == pytest.approx(0.06 ** 2 / (FS / 2), rel=0.1)
+    assert floor.share > 0.8 and floor.dynamic_range > 1e3
+
+
+def test_an_excitation_that_fills_the_band_has_no_floor():
+    # a flat excitation looks like a floor on the input channel alone: not taken for noise
+    rng = np.random.default_rng(1)
+    white = rng.standard_normal(N)
+    assert noise_floor(white + 0.01 * rng.standard_normal(N), FS, 92.0) is None
+    assert noise_floor(_multisine(rng, 0.5, 90.0, lines=400) + 0.01 * rng.standard_normal(N),
+                       FS, 92.0) is None
+
+
+def test_the_model_input_keeps_the_excitation_and_drops_the_noise_only_bins():
+    rng = np.random.default_rng(2)
+    clean = _multisine(rng, 0.4, 3.0)
+    noisy = clean + 0.06 * rng.standard_normal(N)
+    floor = noise_floor(noisy, FS, 92.0)
+    out = wiener_input(noisy, FS, floor)
+    f, s_out = psd(out, FS, 2.0)
+    quiet = (f > 10.0) & (f < 92.0)
+    assert np.max(s_out[quiet]) < 1e-3 * floor.level
+    inner = slice(int(2 * FS), -int(2 * FS))
+    # the excitation's band keeps its noise (small against the lines), nothing else is lost
+    assert np.sqrt(np.mean((out - clean)[inner] ** 2)) < 0.25 * 0.06   # 0.06 as recorded
+
+
+def test_the_gain_rises_from_the_floor_to_its_spread():
+    floor = NoiseFloor(1.0, (0.1, 90.0), 0.9, 100.0)
+    g = input_gain(np.zeros(4), np.array([0.5, 1.5, 2.0, 3.0]), floor)
+    assert g[0] == g[1] == 0.0 and g[3] == 1.0 and 0.0 < g[2] < 1.0
