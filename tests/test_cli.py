@@ -167,6 +167,9 @@ def test_without_a_measured_friction_the_priors_span_the_damping_split():
     assert specs["c_m"].mean == pytest.approx(180.0, rel=0.05) and specs["c_m"].sd == 50.0
     specs = recording_priors(df, dict(TABLE1_KNOWN), {"F_c": {"mean": 8.4, "sd": 1.0}})
     assert specs["c_m"].mean < 9.0 and specs["c_m"].sd == 50.0
+    # a stated noise prior (a sidecar's, or the grid's) is taken with its unit
+    sigma = recording_priors(df, dict(TABLE1_KNOWN), {"sigma": {"mean": 0.07, "sd": 0.03}})
+    assert sigma["sigma"].unit == "m/s^2" and sigma["sigma"].mean == 0.07
     # the quadratic-damping candidate's prior keeps a positive scale
     scale = DeviceScale(force=5.0, v=0.05, z=0.01, f_high=20.0, M=12.8, m=8.0, k=250.0,
                         z_quantiles={0.75: 0.01})

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from harvester.data.input_noise import NoiseFloor, input_gain, noise_floor, wiener_input
+from harvester.data.input_noise import NoiseFloor, input_gain, noise_floor, without_floor
 from harvester.data.signals import psd
 
 FS = 256.0
@@ -41,7 +41,7 @@ def test_the_model_input_keeps_the_excitation_and_drops_the_noise_only_bins():
     clean = _multisine(rng, 0.4, 3.0)
     noisy = clean + 0.06 * rng.standard_normal(N)
     floor = noise_floor(noisy, FS, 92.0)
-    out = wiener_input(noisy, FS, floor)
+    out = without_floor(noisy, FS, floor)
     f, s_out = psd(out, FS, 2.0)
     quiet = (f > 10.0) & (f < 92.0)
     assert np.max(s_out[quiet]) < 1e-3 * floor.level

@@ -13,8 +13,8 @@ naming modes at 29-88 Hz and a mass error.
 
 Remedy: drive the model with the input's bins that carry excitation only, W y''_m, with
 W(f) = 0 where the input's Welch PSD S_y(f) lies on its white noise floor N0 (below
-FLOOR_EDGE x N0), 1 where it lies above FLOOR_SPREAD x N0, a raised cosine between. A Wiener gain 1 - N0 / S_y would leave the
-floor's upward scatter in (measured: the detection's largest score fell from 6.9 to 4.7 sd
+FLOOR_EDGE x N0), 1 where it lies above FLOOR_SPREAD x N0, a raised cosine between. A
+Wiener gain 1 - N0 / S_y would leave the floor's upward scatter in (measured: the detection's largest score fell from 6.9 to 4.7 sd
 only) and scale the excitation's lines by S / (S + N0), a mass-like error of its own. N0 is found only where the input
 shows one (:func:`noise_floor`): a flat floor over at least FLOOR_SHARE of the analysed band,
 at least FLOOR_RANGE below the input's strongest line. An input whose excitation fills the band
@@ -97,7 +97,7 @@ def input_gain(f: ArrayLike, s: ArrayLike, floor: NoiseFloor) -> NDArray[np.floa
     return 0.5 - 0.5 * np.cos(np.pi * rise)
 
 
-def wiener_input(x: ArrayLike, fs: float, floor: NoiseFloor) -> NDArray[np.float64]:
+def without_floor(x: ArrayLike, fs: float, floor: NoiseFloor) -> NDArray[np.float64]:
     """``x`` without its bins on the noise floor: zero-phase gain :func:`input_gain` of its
     Welch PSD, interpolated to the record's DFT grid. The record is mirrored at both ends
     before the DFT so that the gain's response does not wrap round."""

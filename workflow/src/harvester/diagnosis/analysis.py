@@ -20,7 +20,7 @@ import pandas as pd
 
 from harvester.data.daq import RECORDING_COLUMNS
 from harvester.data.errors import DataError
-from harvester.data.input_noise import NoiseFloor, noise_floor, wiener_input
+from harvester.data.input_noise import NoiseFloor, noise_floor, without_floor
 from harvester.data.signals import resample_recording, resampling_ratio, uniform_step
 from harvester.diagnosis.baseline import ChainProblem, baseline_state, chain_problem, fit_map
 from harvester.diagnosis.confirm import ModelFit, fit_structure, map_reference
@@ -173,20 +173,20 @@ def prepare(recording: pd.DataFrame, validation: pd.DataFrame | None,
 
 def model_input(rec: pd.DataFrame, validation: pd.DataFrame | None, fs: float, f_high: float,
                 notes: list[str]) -> tuple[pd.DataFrame, pd.DataFrame | None, NoiseFloor | None]:
-    """The recordings with the base acceleration the models are driven by: its Wiener
-    estimate where the channel shows a noise floor below ``f_high`` Hz
+    """The recordings with the base acceleration the models are driven by: without its bins
+    on the channel's noise floor where it shows one below ``f_high`` Hz
     (:mod:`harvester.data.input_noise`; the validation record with the training record's
     floor), else as recorded. Copies; the recordings passed in are not changed."""
     floor = noise_floor(rec["base_acc"].to_numpy(), fs, f_high)
     if floor is None:
         return rec, validation, None
-    out = [r if r is None else r.assign(base_acc=wiener_input(r["base_acc"].to_numpy(), fs,
+    out = [r if r is None else r.assign(base_acc=without_floor(r["base_acc"].to_numpy(), fs,
                                                                 floor))
            for r in (rec, validation)]
     line = (f"base_acc shows a white noise floor of {floor.rms:.3g} RMS over "
             f"{floor.band_hz[0]:.2g}-{floor.band_hz[1]:.3g} Hz ({floor.share:.0%} of the band, "
             f"{floor.dynamic_range:.3g} x below its strongest line): the models are driven by "
-            "its Wiener estimate, so that the input's noise does not reach the residual "
+            "its bins above that floor, so that the input's noise does not reach the residual "
             "through them")
     log.info("%s", line)
     notes.append(line)

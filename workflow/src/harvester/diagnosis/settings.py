@@ -34,8 +34,8 @@ class DiagnosisSettings:
     the detection's scan (``confirm.candidate_reference``); the tempering path changes, not
     the posterior or the evidence. False: every model from its prior. enlargements: how often
     a model whose two chains disagree by more than a nat is sampled again with twice the
-    particles. denoise_input: drive the models with the Wiener estimate of the base
-    acceleration where its channel shows a noise floor (``data.input_noise``); False: as
+    particles. denoise_input: drive the models with the base acceleration without its
+    bins on the channel's noise floor, where it shows one (``data.input_noise``); False: as
     recorded.
     """
 

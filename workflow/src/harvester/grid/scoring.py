@@ -79,6 +79,7 @@ def run_diagnosis(recording: pd.DataFrame, baseline: str, known: Mapping[str, fl
     """
     from harvester.diagnosis.run import DiagnosisSettings, diagnose
     from harvester.inference.priors import PriorSpec
+    from harvester.initial.recording import recording_priors
     from harvester.data.signals import uniform_step
 
     start = time.perf_counter()
@@ -89,8 +90,10 @@ def run_diagnosis(recording: pd.DataFrame, baseline: str, known: Mapping[str, fl
     settings = DiagnosisSettings.fast(fit_seconds=15.0, **common) if fast \
         else DiagnosisSettings(**common)
     given = {"sigma": SIGMA_PRIOR, **(priors or {})}
-    specs = {n: p if isinstance(p, PriorSpec) else PriorSpec(name=n, **p)
-             for n, p in given.items()}
+    stated = {n: p for n, p in given.items() if isinstance(p, PriorSpec)}
+    entries = {n: p for n, p in given.items() if not isinstance(p, PriorSpec)}
+    # as `harvester diagnose` does: the baseline's priors from the recording's FRF
+    specs = {**recording_priors(recording, known, entries, "<scenario>"), **stated}
     out = diagnose(recording, baseline, known, specs, settings=settings).to_dict()
     out["runtime_s"] = time.perf_counter() - start
     out["implementation"] = "harvester.diagnosis.diagnose" + (" (fast)" if fast else "")

@@ -67,6 +67,10 @@ def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
     return {**specs, **stated}
 
 
+#: Unit and bound of a stated noise sd prior (the library's terms have no sigma).
+NOISE_PRIOR_BASE = PriorSpec("sigma", 1.0, 1.0, "m/s^2", 0.0)
+
+
 def _stated_priors(given: Mapping[str, Mapping[str, float]],
                    specs: Mapping[str, PriorSpec]) -> dict[str, PriorSpec]:
     """The priors ``given`` (config ``priors`` entries), with the unit and lower bound of
@@ -76,7 +80,7 @@ def _stated_priors(given: Mapping[str, Mapping[str, float]],
 
     stated = {}
     for name, entry in given.items():
-        base = specs.get(name) or default_prior(name)
+        base = specs.get(name) or (NOISE_PRIOR_BASE if name == "sigma" else default_prior(name))
         stated[name] = prior_spec(name, {"unit": base.unit, "lower": base.lower, **entry},
                                   TABLE1)
     return stated
