@@ -383,6 +383,24 @@ def test_a_candidate_is_sampled_unless_its_evidence_bound_rules_it_out():
     assert skip_reason(_screened("inertia_error", 398.0), best * 3, cs, 3) is not None  # top
 
 
+def test_a_candidate_piled_where_it_stands_for_another_term_brings_that_term_in():
+    # Karnopp's stick on the literature generator: the Dahl term's pre-sliding displacement
+    # piled at its lower bound, where the law is Coulomb's
+    from types import SimpleNamespace
+
+    from harvester.diagnosis.confirm import limit_candidates
+    from harvester.model.structures import structure
+
+    tanh = structure("tanh")
+    piled = SimpleNamespace(effect="hysteresis", at_prior_edge={"delta_hyst": "lower"})
+    assert limit_candidates(piled, tanh, ["hysteresis"]) == ["coulomb_friction"]
+    assert limit_candidates(piled, tanh, ["hysteresis", "coulomb_friction"]) == []
+    other_side = SimpleNamespace(effect="hysteresis", at_prior_edge={"delta_hyst": "upper"})
+    assert limit_candidates(other_side, tanh, ["hysteresis"]) == []
+    mode = SimpleNamespace(effect="unmodelled_mode", at_prior_edge={"f_mode": "upper"})
+    assert limit_candidates(mode, tanh, ["unmodelled_mode"]) == ["inertia_error"]
+
+
 def test_a_trusted_importance_estimate_rules_out_what_the_bound_cannot():
     from harvester.diagnosis.confirm import ConfirmSettings, skip_reason
     from harvester.inference.importance import ImportanceEstimate

@@ -19,6 +19,14 @@ def test_every_term_is_complete_and_in_a_file_named_for_it():
         assert t.source.endswith(f"{name}.py")
 
 
+def test_a_terms_limits_name_terms_of_the_library():
+    for t in TERMS.values():
+        for parameter, side, other in t.limits:
+            assert other in TERMS and t.limit(parameter, side) == other
+    assert TERMS["hysteresis"].limit("delta_hyst", "lower") == "coulomb_friction"
+    assert TERMS["hysteresis"].limit("delta_hyst", "upper") is None
+
+
 def test_parameter_names_are_unique_across_the_library():
     names = [p.name for p in BASE_PARAMETERS] + [p for t in TERMS.values()
                                                  for p in t.parameter_names]
@@ -36,6 +44,7 @@ def test_parameter_names_are_unique_across_the_library():
     (dict(parameters=(Parameter("F_x", "N", Prior("loguniform", 0.1, 1.0), "d"),)), "why"),
     (dict(parameters=(Parameter("F_x", "N", Prior("loguniform", 1.0, 0.1, why="r"), "d"),)),
      "lower < upper"),
+    (dict(limits=(("F_x", "lower", "coulomb_friction"),)), "limit"),
 ])
 def test_registry_refuses_an_incomplete_term(change, message):
     bad = replace(TERMS["coulomb_friction"], name="bad_term", **change)

@@ -52,6 +52,7 @@ import numpy as np
 
 from harvester.diagnosis.baseline import ChainProblem, chain_problem
 from harvester.diagnosis.detect import Detection, at_prior_edge
+from harvester.diagnosis.signatures import candidate_terms
 from harvester.model.priors import DeviceScale
 from harvester.inference.evidence import BridgeEstimate, chains_bridge_log_evidence, log_target
 from harvester.inference.identify import TMCMCSettings, identify
@@ -523,9 +524,12 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
     fits (``diagnosis.screen``); then they are sampled in its order, at most ``top`` of them,
     and one whose evidence bound rules it out is not sampled (:func:`skip_reason`)."""
     fitted = {s.effect: s for s in screen.candidates} if screen is not None else {}
-    order = screen.order if screen is not None else list(effects)
+    order = list(screen.order if screen is not None else effects)
     results = []
-    for i, effect in enumerate(order):
+    i = -1
+    while i + 1 < len(order):
+        i += 1
+        effect = order[i]
         screened = fitted.get(effect)
         reason = skip_reason(screened, results, settings, top, baseline.log_evidence_se)
         if reason is not None:
@@ -541,9 +545,26 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
         results.append(judge(effect, fit, baseline, settings))
         if screened is not None:
             screened.sampled = True
+        order[i + 1:i + 1] = limit_candidates(results[-1], baseline.structure, order)
     results.sort(key=lambda r: -r.delta_log_evidence)
     mark_ties(results, settings)
     return results
+
+
+def limit_candidates(result: CandidateResult, structure: ModelStructure,
+                     order: list[str]) -> list[str]:
+    """The terms a candidate stands for where its posterior piled against a bound
+    (``Term.limits``), that the structure can take and the round has not listed: sampled
+    next, in its place (unscreened, so always)."""
+    allowed = set(candidate_terms(structure.terms))
+    out = []
+    for name, side in result.at_prior_edge.items():
+        other = term(result.effect).limit(name, side)
+        if other and other in allowed and other not in order and other not in out:
+            log.info("%s: %s piles against its %s bound, where the term stands for %s: "
+                     "sampling %s too", result.effect, name, side, other, other)
+            out.append(other)
+    return out
 
 
 def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSettings,

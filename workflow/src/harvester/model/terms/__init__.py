@@ -138,7 +138,10 @@ class Term:
     internal states the term adds. ``displacement_update`` (a ``screw`` term with one state
     whose law is rate-independent): the state after a monotone screw displacement dx, exact,
     so that the integrator advances the state by it and the state's own relaxation rate does
-    not bound the step.
+    not bound the step. ``limits``: (parameter, 'lower' | 'upper', term): at that bound of the
+    parameter's prior the term stands for another (a pre-sliding displacement below what the
+    data resolve is Coulomb friction; a mode far above the band is a mass). A posterior piled
+    there is not trusted, and the diagnosis samples the other term in its place.
     """
 
     name: str
@@ -155,7 +158,13 @@ class Term:
     displacement_update: Callable | None = None
     refines: tuple[str, ...] = ()
     alike: tuple[str, ...] = ()
+    limits: tuple[tuple[str, str, str], ...] = ()
     source: str = field(default="", compare=False)  # the file that defines the term
+
+    def limit(self, parameter: str, side: str) -> str | None:
+        """The term this one stands for where ``parameter`` piles against ``side`` of its
+        prior (``limits``), or None."""
+        return next((t for p, s, t in self.limits if (p, s) == (parameter, side)), None)
 
     @property
     def parameter_names(self) -> tuple[str, ...]:
@@ -210,6 +219,10 @@ def check_term(t: Term) -> None:
         except ValueError as err:
             problems.append(f"parameter {p.name}: {err}")
     names = [p.name for p in t.parameters]
+    for parameter, side, other in t.limits:
+        if parameter not in names or side not in ("lower", "upper") or other == t.name:
+            problems.append(f"limit ({parameter}, {side}, {other}): a parameter of the term, "
+                            "'lower' or 'upper', and another term")
     bad = [n for n in names if not n.isidentifier() or n.startswith("_")]
     if bad:
         problems.append(f"parameter names {bad} must be identifiers not starting with '_'")

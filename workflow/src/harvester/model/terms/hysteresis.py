@@ -95,6 +95,9 @@ TERM = Term(
     description="pre-sliding friction with memory and bristle damping (Dahl, LuGre)",
     force=force, state_rates=state_rates, rate_bound=rate_bound,
     displacement_update=displacement_update,
+    # below 1/300 of the RMS displacement the data cannot tell the law from a sign law: a
+    # posterior piled there asks for Coulomb friction (a stick, Karnopp's, say)
+    limits=(("delta_hyst", "lower", "coulomb_friction"),),
     probe=Probe("F_hyst", lambda d: 0.1 * d.force,
                 shapes=lambda d: [{"delta_hyst": f * d.z, "c_hyst": c * d.force / d.v}
                                   for f in (0.01, 0.1) for c in BRISTLE_DAMPING_SHAPES]),

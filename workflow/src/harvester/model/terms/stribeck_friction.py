@@ -45,10 +45,12 @@ TERM = Term(
                 "the motion shows"),
             "excess of breakaway over sliding friction"),
         Parameter("v_stribeck", "m/s", Prior(
-            "loguniform", 1.0 / 30.0, 3.0, "v",
-            why="the Stribeck velocity from 1/30 of the RMS velocity to 3 x it: below, the "
-                "excess lives within the recording's velocity resolution; above, it is "
-                "viscous-like"),
+            "loguniform", 1.0 / 100.0, 3.0, "v",
+            why="the Stribeck velocity from 1/100 of the RMS velocity to 3 x it: Stribeck "
+                "velocities span 1e-5 to 1e-1 m/s (Armstrong-Helouvry et al. 1994), and "
+                "below 1/100 of the RMS velocity (a shaker record's velocity resolution, as "
+                "for the tanh law's transition) the excess cannot be resolved; above 3 x it, "
+                "it is viscous-like"),
             "Stribeck velocity"),
         Parameter("delta_stribeck", "-", Prior(
             "normal", 1.5, 0.5, lower=0.5, upper=3.0,
@@ -60,5 +62,5 @@ TERM = Term(
     description="Stribeck effect: friction falls from breakaway as sliding speeds up",
     force=force, rate_bound=rate_bound, refines=SLIDING_FRICTION,
     probe=Probe("F_stribeck", lambda d: 1.0,
-                shapes=lambda d: [{"v_stribeck": f * d.v} for f in (0.1, 0.3, 1.0)]),
+                shapes=lambda d: [{"v_stribeck": f * d.v} for f in (0.01, 0.03, 0.1, 0.3, 1.0)]),
     source=__file__)

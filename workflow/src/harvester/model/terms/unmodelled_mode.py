@@ -68,6 +68,9 @@ TERM = Term(
              "m_2 (w_n^2 u + 2 zeta w_n u')",
     description="secondary resonance inside the band, on the mass or the screw side",
     force=force, state_rates=state_rates, rate_bound=rate_bound,
+    # far above the band a mode moves with the mass: a posterior piled at the top asks for a
+    # mass error
+    limits=(("f_mode", "upper", "inertia_error"),),
     probe=Probe("mass_mode", lambda d: 0.004 * d.M,
                 shapes=lambda d: [{"f_mode": f, "zeta_mode": 0.15, "drive_base": b}
                                   for b in (1.0, 0.0) for f in _frequency_grid(d)],
