@@ -271,6 +271,28 @@ def test_information_is_the_tempered_likelihood_gain_of_what_the_baseline_leaves
     assert not rows.loc[("none_tanh", 0), "nameable"]  # effect-free: nothing to name
 
 
+def test_the_refit_measures_what_the_baseline_cannot_absorb():
+    # extra viscous damping is c_m's to absorb; a cubic spring is not
+    from harvester.grid.information import refit_unabsorbed
+    from harvester.study.paper import TABLE1_KNOWN
+    from harvester.synthetic.measured import measured_recording
+
+    base = {**TABLE1_KNOWN, "c_m": 110.0, "F_c": 11.86, "beta": 88.35}
+    kw = dict(noise_m_s2=0.0, lowpass_hz=None)
+    plain, clean = measured_recording(("tanh_friction",), base, 8.0, 3, **kw)
+    _, damped = measured_recording(("tanh_friction",), {**base, "c_m": 130.0}, 8.0, 3, **kw)
+    _, cubic = measured_recording(("tanh_friction", "cubic_stiffness"),
+                                  {**base, "k_cubic": 4e6}, 8.0, 3, **kw)
+    known = {k: TABLE1_KNOWN[k] for k in ("M", "m", "k")}
+    window = (256, 7 * 256)
+    noise = 0.05
+    assert refit_unabsorbed(plain, damped, clean, known, noise, window=window) < 0.05
+    assert refit_unabsorbed(plain, cubic, clean, known, noise, window=window) > 0.2
+    truth = {**_truth("cubic_stiffness", 0.5, 0), "unabsorbed_to_noise": 0.4,
+             "refit_unabsorbed_to_noise": 0.0}
+    assert det.information_nats(truth, _informed(_diag())) == 0.0   # the refit's u is used
+
+
 def test_goal_summary_pools_effects_and_separates_the_nameable():
     def pair(effect, seed, u, *missing, tie=None):
         d = _informed(_tie(*tie) if tie else _diag(*missing))
@@ -319,5 +341,6 @@ def test_literature_generator_writes_a_scenario_the_grid_scores(tmp_path):
     assert list(rec.columns)[:3] == ["time", "base_acc", "rel_acc"] and len(rec) == 6 * 256
     row = det.score(truth, _diag("cubic_stiffness"))
     assert row["outcome"] == "named"
+    assert truth["refit_unabsorbed_to_noise"] > 0.0
     with pytest.raises(ValueError, match="generator"):
         make_scenario_files("mine", "duffing", 0.5, 0, {}, {}, {}, csv, js)

@@ -150,12 +150,9 @@ def prepare(recording: pd.DataFrame, validation: pd.DataFrame | None,
     floor = None
     if settings.denoise_input:
         rec, validation, floor = model_input(rec, validation, fs, band_top(fs, lowpass), notes)
-    lead = int(round(settings.lead_in_s * fs))
-    # the analysis stops half a second before the record's end (the zero-phase filters'
-    # end effects) or where the held-out tail starts
-    end = n - int(round(0.5 * fs))
-    hold = end if validation is not None else \
-        lead + int(round((end - lead) * (1.0 - settings.holdout_fraction)))
+    lead, hold, end = analysis_window(n, fs, settings.lead_in_s,
+                                      0.0 if validation is not None else
+                                      settings.holdout_fraction)
     fit_stop = hold if settings.fit_seconds is None else \
         min(hold, lead + int(round(settings.fit_seconds * fs)))
     out = Analysis(rec, validation, base, dict(known), dt, lowpass, settings.filter_order,
@@ -169,6 +166,18 @@ def prepare(recording: pd.DataFrame, validation: pd.DataFrame | None,
     for line in settings.trades():
         log.warning("these settings trade away: %s", line)
     return out
+
+
+def analysis_window(n: int, fs: float, lead_in_s: float, holdout_fraction: float
+                    ) -> tuple[int, int, int]:
+    """(lead, hold, end) samples of a record of ``n`` samples at ``fs`` Hz: the analysis
+    starts after the lead-in and stops half a second before the record's end (the zero-phase
+    filters' end effects) or where the held-out tail (``holdout_fraction`` of the rest)
+    starts."""
+    lead = int(round(lead_in_s * fs))
+    end = n - int(round(0.5 * fs))
+    hold = lead + int(round((end - lead) * (1.0 - holdout_fraction)))
+    return lead, hold, end
 
 
 def model_input(rec: pd.DataFrame, validation: pd.DataFrame | None, fs: float, f_high: float,

@@ -29,6 +29,9 @@ rate at alpha, whatever the method; it is counted as not ``nameable`` and the ta
 rate named among the nameable scenarios beside the plain rate. The bound is approximate: the
 nonlinear refit absorbs a little more than the linearised one (an inertia error of the medium
 grid: 2.45 nats by the formula, 1.84 from the likelihood itself at the true parameters).
+Where the truth gives ``refit_unabsorbed_to_noise`` (the literature generator's records:
+the baseline's MAP refitted to the noise-free record, ``harvester.grid.information``), u is
+that instead: a linearised fit misses what a large move of the baseline's parameters absorbs.
 """
 
 from __future__ import annotations
@@ -146,12 +149,13 @@ def outcome(diagnosis: Mapping[str, Any], correct: set[str]) -> str:
 
 def information_nats(truth: Mapping[str, Any], diagnosis: Mapping[str, Any]) -> float:
     """Expected tempered log-likelihood gain (nats) of the true effect at its true parameters
-    over the refitted baseline: lambda n u^2 / 2 (module docstring). NaN where the diagnosis
+    over the refitted baseline: lambda n u^2 / 2, u the refit's where the truth has it
+    (module docstring). NaN where the diagnosis
     does not give lambda, its analysis rate and TMCMC window, or the truth no ``u``."""
     chain = diagnosis.get("measurement_chain") or {}
     lam, rate = chain.get("tempering_lambda"), chain.get("analysis_rate_hz")
     window = diagnosis.get("tmcmc_window_s")
-    u = truth.get("unabsorbed_to_noise")
+    u = truth.get("refit_unabsorbed_to_noise", truth.get("unabsorbed_to_noise"))
     if lam is None or rate is None or not window or u is None:
         return float("nan")
     n = round((float(window[1]) - float(window[0])) * float(rate)) + 1
