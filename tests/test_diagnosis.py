@@ -399,6 +399,11 @@ def test_a_candidate_piled_where_it_stands_for_another_term_brings_that_term_in(
     assert limit_candidates(other_side, tanh, ["hysteresis"]) == []
     mode = SimpleNamespace(effect="unmodelled_mode", at_prior_edge={"f_mode": "upper"})
     assert limit_candidates(mode, tanh, ["unmodelled_mode"]) == ["inertia_error"]
+    # and it is that term's physics, not a rival explanation of it
+    from harvester.diagnosis.confirm import becomes
+
+    assert becomes(mode, "inertia_error") and not becomes(mode, "cubic_stiffness")
+    assert not becomes(other_side, "coulomb_friction")
 
 
 def test_a_trusted_importance_estimate_rules_out_what_the_bound_cannot():

@@ -645,9 +645,17 @@ def judge(effect: str, fit: ModelFit, baseline: ModelFit, settings: ConfirmSetti
                            bool(delta > threshold and not edges), at_prior_edge=edges)
 
 
+def becomes(result: CandidateResult, effect: str) -> bool:
+    """Whether ``result``'s posterior piles against a bound where its term becomes
+    ``effect`` (``Term.limits``): a mode pushed far above the band is the mass error."""
+    return any(term(result.effect).limit(name, side) == effect
+               for name, side in result.at_prior_edge.items())
+
+
 def mark_ties(results: list[CandidateResult], settings: ConfirmSettings) -> None:
     """The best accepted candidate is named alone only if every physically different
-    candidate (``harvester.model.terms.same_physics``) trails it by more than the acceptance
+    candidate (``harvester.model.terms.same_physics``; not one piled at the bound where it
+    becomes the best's term, :func:`becomes`) trails it by more than the acceptance
     threshold (log(1/alpha) plus mc_sigmas standard errors of the gap); the others within it
     are recorded as indistinguishable from it, both ways. ``results`` best first."""
     accepted = [r for r in results if r.accepted]
@@ -655,7 +663,7 @@ def mark_ties(results: list[CandidateResult], settings: ConfirmSettings) -> None
         return
     best = accepted[0]
     for r in results:
-        if r is best or same_physics(r.effect, best.effect):
+        if r is best or same_physics(r.effect, best.effect) or becomes(r, best.effect):
             continue
         gap = best.delta_log_evidence - r.delta_log_evidence
         margin = settings.base_threshold + settings.mc_sigmas * np.hypot(best.delta_se,
