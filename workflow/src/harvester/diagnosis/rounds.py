@@ -70,9 +70,11 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
         rnd = detect_round(analysis, start, now, settings, r)
         rounds.append(rnd)
         det = rnd.detection
-        if r == settings.rounds or not (det.significant or det.conflict):
-            break
+        # a candidate whose own score is significant is screened even where the family's
+        # maximum is not: the evidence, not the detection, decides what is named
         chosen = to_confirm(rnd.ranked, det, settings.screen)
+        if r == settings.rounds or not (det.significant or det.conflict or chosen):
+            break
         if not chosen:
             unexplained = unexplained or det.significant
             if det.significant:
