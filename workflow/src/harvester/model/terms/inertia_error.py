@@ -33,11 +33,14 @@ TERM = Term(
                 "sd (a forgotten payload, a mis-stated rotor inertia)"),
             "error of the assumed effective mass"),
         Parameter("m_share", "-", Prior(
-            "normal", 0.5, 0.5,
-            why="between an error of the screw-side inertia (0) and of the payload (1)"),
+            "normal", 0.5, 0.5, lower=None,
+            why="between an error of the screw-side inertia (0) and of the payload (1), "
+                "unbounded: both ends are physical (a rotor error alone is exactly 0, and a "
+                "bound there made its posterior pile against it), and errors of opposite "
+                "sign lie beyond them"),
             "share of dM on the oscillating mass, which also drives the device (-m y''): "
             "1 for a payload error, 0 for an error of the screw-side inertia "
-            "J (2 pi / l)^2 alone, above 1 when the two errors differ in sign"),
+            "J (2 pi / l)^2 alone, below 0 or above 1 when the two errors differ in sign"),
     ),
     equation="M -> M + dM, m -> m + m_share dM (eq. 2: M = m + J (2 pi / l)^2)",
     description="effective mass differs from the assumed value",

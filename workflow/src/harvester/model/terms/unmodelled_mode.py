@@ -58,8 +58,10 @@ TERM = Term(
             why="a modal mass from a thousandth of the effective mass to all of it"),
             "modal mass of the secondary mode"),
         Parameter("drive_base", "-", Prior(
-            "normal", 0.5, 0.5,
-            why="between a mode on the mass (1) and one on the screw side (0)"),
+            "normal", 0.5, 0.5, lower=None,
+            why="between a mode on the mass (1) and one on the screw side (0), unbounded: "
+                "a mode on the screw side is exactly 0, and a bound there made its "
+                "posterior pile against it"),
             "share of the base acceleration in the mode's drive: 1 for a mode attached "
             "to the mass (driven by its absolute acceleration x'' = z'' + y''), 0 for "
             "one on the screw side (a rotor on a flexible coupling, driven by z'')"),
