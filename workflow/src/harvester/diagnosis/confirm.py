@@ -525,13 +525,15 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
     and one whose evidence bound rules it out is not sampled (:func:`skip_reason`)."""
     fitted = {s.effect: s for s in screen.candidates} if screen is not None else {}
     order = list(screen.order if screen is not None else effects)
+    single = detection is not None and not (detection.significant or detection.conflict)
     results = []
     i = -1
     while i + 1 < len(order):
         i += 1
         effect = order[i]
         screened = fitted.get(effect)
-        reason = skip_reason(screened, results, settings, top, baseline.log_evidence_se)
+        reason = skip_reason(screened, results, settings, top, baseline.log_evidence_se,
+                             single)
         if reason is not None:
             screened.skipped = reason
             log.info("%s not sampled: %s", effect, reason)
@@ -568,7 +570,8 @@ def limit_candidates(result: CandidateResult, structure: ModelStructure,
 
 
 def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSettings,
-                top: int | None, nested_se: float = BRIDGE_MIN_SE) -> str | None:
+                top: int | None, nested_se: float = BRIDGE_MIN_SE,
+                single_scores: bool = False) -> str | None:
     """Why a screened candidate (``diagnosis.screen.Screened``) need not be sampled: ``top``
     candidates were sampled already, or its evidence bound (``Screened.bound``) or its
     importance-sampling ceiling (``Screened.importance_ceiling``, where trusted) lies below the
@@ -578,7 +581,9 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     neither be accepted nor tie with the best. A candidate whose fit failed (fell below the
     nested model's: an optimiser that missed, or an effect whose smallest admissible size
     already costs) is ruled out by a trusted importance-sampling estimate alone, which does
-    not rest on the fit. None: sample it (always where it was not screened)."""
+    not rest on the fit; in a round opened by single effects' scores (``single_scores``: the
+    family's test not significant, no conflict) such a candidate is not sampled at all, as
+    nothing supports it. None: sample it (always where it was not screened)."""
     if screened is None:
         return None
     if top is not None and len(results) >= top:
@@ -590,6 +595,9 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
         if ceiling is not None and ceiling < least:
             return (f"its fit fell below the nested model's; {screened.importance_phrase()}, "
                     f"at most {ceiling:.1f}, below the acceptance threshold {least:.1f}")
+        if single_scores:
+            return ("its fit fell below the nested model's, and the round was opened by single "
+                    "effects' scores, not by the family's test")
         return None
     if screened.bound < least:
         return (f"its best fit gains at most {screened.bound:.1f} nats of evidence, below the "
