@@ -428,6 +428,10 @@ def test_a_failed_fit_is_ruled_out_only_by_a_trusted_importance_estimate():
     assert skip_reason(stop, [], cs, 3) is None
     # in a round the family's test did not open, nothing supports it
     assert "single effects' scores" in skip_reason(stop, [], cs, 3, single_scores=True)
+    # nor once another candidate is accepted
+    from types import SimpleNamespace
+    mode = SimpleNamespace(effect="unmodelled_mode", accepted=True)
+    assert "unmodelled_mode was accepted" in skip_reason(stop, [mode], cs, 3)
     stop.importance = ImportanceEstimate(4035.0, 0.3, 0.5, 200.0, 1000)
     stop.importance_gain, stop.importance_gain_se = -360.0, 0.3
     assert skip_reason(stop, [], cs, 3) is None  # not trusted: sampled

@@ -582,8 +582,9 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     nested model's: an optimiser that missed, or an effect whose smallest admissible size
     already costs) is ruled out by a trusted importance-sampling estimate alone, which does
     not rest on the fit; in a round opened by single effects' scores (``single_scores``: the
-    family's test not significant, no conflict) such a candidate is not sampled at all, as
-    nothing supports it. None: sample it (always where it was not screened)."""
+    family's test not significant, no conflict), or once another candidate was accepted, such
+    a candidate is not sampled at all: nothing supports it, and its sampling is where stiff
+    contacts spend an hour. None: sample it (always where it was not screened)."""
     if screened is None:
         return None
     if top is not None and len(results) >= top:
@@ -598,6 +599,10 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
         if single_scores:
             return ("its fit fell below the nested model's, and the round was opened by single "
                     "effects' scores, not by the family's test")
+        accepted = [r.effect for r in results if r.accepted]
+        if accepted:
+            return (f"its fit fell below the nested model's and {accepted[0]} was accepted; "
+                    f"{screened.importance_phrase()}: its evidence is not known")
         return None
     if screened.bound < least:
         return (f"its best fit gains at most {screened.bound:.1f} nats of evidence, below the "
