@@ -41,6 +41,13 @@ def _frequency_grid(d) -> list[float]:
     return list(np.geomspace(1.5, top, 1 + int(np.log(top / 1.5) / np.log(1.2))))
 
 
+#: The probes' damping ratios: a heavily damped mount and a sharp structural mode. With the
+#: first alone, a mode at 11.4 Hz with zeta 0.019 on the literature generator (refit
+#: information about 500 nats) scored z < 1.5 and the detection gave p = 0.157; with both,
+#: z 4.3 at 11.5 Hz and p = 0.005.
+PROBE_DAMPING = (0.15, 0.02)
+
+
 TERM = Term(
     name="unmodelled_mode", kind="mode", n_states=2,
     parameters=(
@@ -74,7 +81,8 @@ TERM = Term(
     # mass error
     limits=(("f_mode", "upper", "inertia_error"),),
     probe=Probe("mass_mode", lambda d: 0.004 * d.M,
-                shapes=lambda d: [{"f_mode": f, "zeta_mode": 0.15, "drive_base": b}
-                                  for b in (1.0, 0.0) for f in _frequency_grid(d)],
+                shapes=lambda d: [{"f_mode": f, "zeta_mode": z, "drive_base": b}
+                                  for z in PROBE_DAMPING for b in (1.0, 0.0)
+                                  for f in _frequency_grid(d)],
                 start_shape="f_mode"),
     source=__file__)
