@@ -14,9 +14,10 @@ naming modes at 29-88 Hz and a mass error.
 Remedy: drive the model with the input's bins that carry excitation only, W y''_m, with
 W(f) = 0 where the input's Welch PSD S_y(f) lies on its white noise floor N0 (below
 FLOOR_EDGE x N0), 1 where it lies above FLOOR_SPREAD x N0, a raised cosine between. A
-Wiener gain 1 - N0 / S_y would leave the floor's upward scatter in (measured: the detection's largest score fell from 6.9 to 4.7 sd
-only) and scale the excitation's lines by S / (S + N0), a mass-like error of its own. N0 is found only where the input
-shows one (:func:`noise_floor`): a flat floor over at least FLOOR_SHARE of the analysed band,
+Wiener gain 1 - N0 / S_y would leave the floor's upward scatter in (measured: the detection's
+largest score fell from 6.9 to 4.7 sd only) and scale the excitation's lines by
+S / (S + N0), a mass-like error of its own. N0 is found only where the input shows one
+(:func:`noise_floor`): a flat floor over at least FLOOR_SHARE of the analysed band,
 at least FLOOR_RANGE below the input's strongest line. An input whose excitation fills the band
 has no floor to find, and its model input is left as recorded: there the noise is a small
 share of every line, and a floor fitted to a flat excitation would take away signal.
@@ -24,12 +25,12 @@ share of every line, and a floor fitted to a flat excitation would take away sig
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from harvester.data.signals import psd
+from harvester.data.signals import apply_gain, psd
 
 #: Welch segment (s) of the floor's PSD.
 FLOOR_SEGMENT_S = 2.0
@@ -64,9 +65,6 @@ class NoiseFloor:
     def rms(self) -> float:
         return float(np.sqrt(self.level * (self.band_hz[1] - self.band_hz[0])))
 
-    def to_dict(self) -> dict:
-        return {**asdict(self), "band_hz": list(self.band_hz), "rms": self.rms}
-
 
 def noise_floor(x: ArrayLike, fs: float, f_high: float) -> NoiseFloor | None:
     """The white floor of ``x`` (sampled at ``fs`` Hz) below ``f_high`` Hz, or None where the
@@ -99,13 +97,8 @@ def input_gain(f: ArrayLike, s: ArrayLike, floor: NoiseFloor) -> NDArray[np.floa
 
 def without_floor(x: ArrayLike, fs: float, floor: NoiseFloor) -> NDArray[np.float64]:
     """``x`` without its bins on the noise floor: zero-phase gain :func:`input_gain` of its
-    Welch PSD, interpolated to the record's DFT grid. The record is mirrored at both ends
-    before the DFT so that the gain's response does not wrap round."""
-    x = np.asarray(x, dtype=float)
+    Welch PSD, interpolated to the record's DFT grid (``signals.apply_gain``)."""
     f, s = psd(x, fs, FLOOR_SEGMENT_S)
-    pad = min(x.size - 1, int(round(2.0 * FLOOR_SEGMENT_S * fs)))
-    ext = np.concatenate([x[pad:0:-1], x, x[-2:-pad - 2:-1]])
-    freqs = np.fft.rfftfreq(ext.size, 1.0 / fs)
-    gain = np.interp(freqs, f, input_gain(f, s, floor))
-    out = np.fft.irfft(np.fft.rfft(ext) * gain, n=ext.size)
-    return out[pad:pad + x.size]
+    gain = input_gain(f, s, floor)
+    return apply_gain(x, fs, lambda freqs: np.interp(freqs, f, gain),
+                      round(2.0 * FLOOR_SEGMENT_S * fs))

@@ -49,6 +49,18 @@ def settling_samples(sos: NDArray[np.float64], tol: float = 1e-12) -> int:
     return int(np.ceil(np.log(tol) / np.log(radius)))
 
 
+def apply_gain(x: ArrayLike, fs: float, gain, pad: int) -> NDArray[np.float64]:
+    """``x`` (last axis, sampled at ``fs`` Hz) through the zero-phase gain ``gain(f)`` (f in
+    Hz on the DFT grid), applied in the frequency domain; the record is mirrored by ``pad``
+    samples at both ends first, so that the gain's response does not wrap round."""
+    x = np.asarray(x, dtype=float)
+    pad = min(x.shape[-1] - 1, int(pad))
+    ext = np.concatenate([x[..., pad:0:-1], x, x[..., -2:-pad - 2:-1]], axis=-1)
+    g = gain(np.fft.rfftfreq(ext.shape[-1], 1.0 / fs))
+    out = np.fft.irfft(np.fft.rfft(ext, axis=-1) * g, n=ext.shape[-1], axis=-1)
+    return out[..., pad:pad + x.shape[-1]]
+
+
 def lowpass(x: ArrayLike, fs: float, cutoff_hz: float, order: int) -> NDArray[np.float64]:
     """Zero-phase low-pass of ``x`` (forward-backward Butterworth, ``sosfiltfilt``).
 

@@ -36,7 +36,8 @@ import numba as nb
 import numpy as np
 from scipy import signal
 
-from harvester.data.signals import ANTIALIAS_FRACTION, ANTIALIAS_ORDER, butterworth_sos
+from harvester.data.signals import (ANTIALIAS_FRACTION, ANTIALIAS_ORDER, apply_gain,
+                                    butterworth_sos)
 from harvester.model import acquisition, codegen
 from harvester.model.structures import Layout
 from harvester.model.terms import step_rates
@@ -201,13 +202,8 @@ def _prepare(layout: Layout, params: np.ndarray, u: np.ndarray, dt: float,
         coarse = np.broadcast_to(np.asarray(n_substeps, dtype=np.int64), (p.shape[0],))
         fine = np.maximum(1, -(-coarse // q)) if q > 1 else coarse.copy()
     if q > 1:
-        u = np.ascontiguousarray(_interpolate(u, q))
+        u = np.ascontiguousarray(signal.resample_poly(u, q, 1)[: u.size * q])
     return p, valid, u, dt / q, fine.astype(np.int64), Blocks.of(fine)
-
-
-def _interpolate(x: np.ndarray, q: int) -> np.ndarray:
-    """The input at q x its rate, band-limited (the acquisition's first step), last axis."""
-    return signal.resample_poly(x, q, 1, axis=-1)[..., : x.shape[-1] * q]
 
 
 def acquired(x: np.ndarray, dt: float, oversample: int) -> np.ndarray:
@@ -230,12 +226,8 @@ def acquired(x: np.ndarray, dt: float, oversample: int) -> np.ndarray:
     # (its FIR's ripple, 1e-3, would otherwise move every record by that much)
     fs_fine = q / dt
     sos = butterworth_sos(fs_fine, ANTIALIAS_FRACTION * fs_fine / (2.0 * q), ANTIALIAS_ORDER)
-    pad = min(x.shape[-1] - 1, ANTIALIAS_PAD)
-    ext = np.concatenate([x[..., pad:0:-1], x, x[..., -2:-pad - 2:-1]], axis=-1)
-    freqs = np.fft.rfftfreq(ext.shape[-1], dt)
-    gain = np.abs(signal.sosfreqz(sos, worN=freqs, fs=fs_fine)[1]) ** 2
-    out = np.fft.irfft(np.fft.rfft(ext, axis=-1) * gain, n=ext.shape[-1], axis=-1)
-    return out[..., pad:pad + x.shape[-1]]
+    return apply_gain(x, 1.0 / dt, lambda f: np.abs(signal.sosfreqz(sos, worN=f, fs=fs_fine)[1])
+                      ** 2, ANTIALIAS_PAD)
 
 
 #: Samples mirrored at each end of a record before :func:`acquired`'s DFT.
