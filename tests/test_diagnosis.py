@@ -397,13 +397,15 @@ def test_a_candidate_piled_where_it_stands_for_another_term_brings_that_term_in(
     assert limit_candidates(piled, tanh, ["hysteresis", "coulomb_friction"]) == []
     other_side = SimpleNamespace(effect="hysteresis", at_prior_edge={"delta_hyst": "upper"})
     assert limit_candidates(other_side, tanh, ["hysteresis"]) == []
+    # a mode's modal mass is part of the stated masses: far above the band it is no mass error
     mode = SimpleNamespace(effect="unmodelled_mode", at_prior_edge={"f_mode": "upper"})
-    assert limit_candidates(mode, tanh, ["unmodelled_mode"]) == ["inertia_error"]
-    # and it is that term's physics, not a rival explanation of it
+    assert limit_candidates(mode, tanh, ["unmodelled_mode"]) == []
+    # and the term it becomes is that term's physics, not a rival explanation of it
     from harvester.diagnosis.confirm import becomes
 
-    assert becomes(mode, "inertia_error") and not becomes(mode, "cubic_stiffness")
+    assert becomes(piled, "coulomb_friction") and not becomes(piled, "cubic_stiffness")
     assert not becomes(other_side, "coulomb_friction")
+    assert not becomes(mode, "inertia_error")
 
 
 def test_a_trusted_importance_estimate_rules_out_what_the_bound_cannot():

@@ -2,7 +2,8 @@
 
 Each round detects and locates the mismatch of the current structure (``detect``), ranks the
 library's effects by how much of it each explains (``rank``), fits the best ``screen`` of them
-by MAP for a bound on the evidence each can gain (``screen``), samples the best few by that
+and their rivals (``rank.rivals``) by MAP for a bound on the evidence each can gain
+(``screen``), samples the best few by that
 bound by TMCMC, skipping those the bound rules out, judges them by evidence (``confirm``),
 and adopts the best accepted one. It stops when
 nothing is detected, nothing is worth sampling, nothing sampled is accepted, or after
@@ -20,7 +21,7 @@ from harvester.diagnosis.analysis import Analysis, BaselineStart
 from harvester.diagnosis.baseline import BaselineState, baseline_state
 from harvester.diagnosis.confirm import CandidateResult, ModelFit, confirm, fit_structure
 from harvester.diagnosis.detect import Detection, detect
-from harvester.diagnosis.rank import RankedCandidate, rank, to_confirm
+from harvester.diagnosis.rank import RankedCandidate, rank, rivals, to_confirm
 from harvester.diagnosis.screen import Screen, screen
 from harvester.diagnosis.settings import DiagnosisSettings
 from harvester.diagnosis.signatures import candidate_terms, motion_scale
@@ -86,7 +87,7 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
                                     settings.confirmation())
             baseline_fit = baseline_fit or now.fit
         scale = rnd.scale = motion_scale(rnd.state, analysis.window, det.frame.f_high)
-        effects = [c.effect for c in chosen]
+        effects = [c.effect for c in chosen + rivals(rnd.ranked, chosen)]
         rnd.screen = screen(now.fit, effects, now.priors, scale, det, settings.seed + r)
         rnd.confirmed = confirm(now.fit, effects, now.priors, settings.confirmation(), scale,
                                 seed_offset=1000 * (r + 1), detection=det, screen=rnd.screen,

@@ -121,7 +121,7 @@ def _rhs_source(terms: tuple[Term, ...], driver: str) -> str:
         k += t.n_states
     args = {i: ", ".join(t.parameter_names) for i, t in enumerate(terms)}
     for i, t in enumerate(terms):
-        if t.kind == "inertia":
+        if t.masses is not None:
             lines.append(f"    _M, _m = _masses{i}(_M, _m, {args[i]})")
     if driver == "base":
         lines += ["    _drive = -_m * _u", "    _yb = _u"]

@@ -26,7 +26,8 @@ of eq. 1). Kinds of term and the signature of their force law:
 ``mass``      f = force(z, *params) on the mass, a function of its displacement
 ``inertia``   (M, m) = masses(M, m, *params): changes the effective and oscillating masses
 ``mode``      a secondary mode with states (u, u'): f = force(u, u', *params) on the mass,
-              (u', u'') = state_rates(u, u', a, y'', *params), a the mass's z''
+              (u', u'') = state_rates(u, u', a, y'', *params), a the mass's z''; its
+              ``masses`` take the modal mass out of the rigid part's
 ``coupling``  a dead zone between the mass and the screw-side inertia (states d, d'):
               f_b = force(d, d', M, m, *params) transmitted between them
 """
@@ -205,8 +206,8 @@ def check_term(t: Term) -> None:
     if t.displacement_update is not None and not (
             t.kind == "screw" and t.n_states == 1 and callable(t.displacement_update)):
         problems.append("displacement_update is for a screw term with one state")
-    if t.kind == "inertia" and not callable(t.masses):
-        problems.append("an inertia term needs masses")
+    if t.kind in ("inertia", "mode") and not callable(t.masses):
+        problems.append(f"an {t.kind} term needs masses")
     if t.kind in ("mode", "coupling") and t.n_states != 2:
         problems.append(f"a {t.kind} term has 2 states, not {t.n_states}")
     for p in t.parameters:
