@@ -343,7 +343,7 @@ def scan_factor(effect: str, detection: Detection | None,
     log-normal components at the scanned values, one grid step wide (the median log
     spacing), weighted by exp(statistic / 2) summed over each value's signatures (the score
     test's likelihood ratio). None where the effect has no start shape or fewer than 3 values
-    were scanned."""
+    were scanned inside its prior."""
     probe = term(effect).probe
     if detection is None or probe.start_shape is None:
         return None
@@ -353,9 +353,11 @@ def scan_factor(effect: str, detection: Detection | None,
     values = np.array([detection.signatures[i].shape[name] for i in idx], dtype=float)
     z = np.asarray(detection.z, dtype=float)[idx]
     stat = z**2 if probe.signed else np.maximum(z, 0.0) ** 2
-    grid = np.unique(values)
     (lower,), (upper,) = support(priors, (name,))
-    if len(grid) < 3 or (np.isfinite(lower) and grid.min() <= lower):
+    inside = (values > lower) & (values < upper)  # the scan may reach beyond the prior
+    values, stat = values[inside], stat[inside]
+    grid = np.unique(values)
+    if len(grid) < 3:
         return None
     half = np.array([np.logaddexp.reduce(0.5 * stat[values == v]) for v in grid])
     step = float(np.median(np.diff(np.log(grid))))
