@@ -364,6 +364,30 @@ def test_the_screen_puts_a_concealed_mode_first_at_its_frequency(concealed_mode)
     assert first.bound > max(s.bound for s in others) + 20.0
 
 
+def test_a_modes_fit_starts_at_its_scanned_shape_inside_the_prior(concealed_mode):
+    # an unfiltered record's band puts the frequency prior's lower end above the scan's first
+    # value: the scan keeps what lies inside, and the fit starts at the whole scanned shape
+    from harvester.diagnosis.confirm import candidate_priors, scan_factor
+    from harvester.diagnosis.screen import scanned_start
+    sc, det, nested, specs, scale = concealed_mode
+    priors = {**candidate_priors("unmodelled_mode", scale, nested.problem.known), **specs,
+              "f_mode": PriorSpec.log_uniform("f_mode", 2.0, 80.0, "Hz")}
+    scan = scan_factor("unmodelled_mode", det, priors)
+    assert scan is not None and min(scan.centres) > 2.0
+    heaviest = scan.centres[int(np.argmax(scan.weights))]
+    assert heaviest == pytest.approx(sc.truth["shape"]["f_mode"], rel=0.2)
+    names = list(nested.structure.with_term("unmodelled_mode").free_parameters)
+    row = np.full(len(names), np.nan)
+    scanned_start(row, names, priors, "unmodelled_mode", det, "f_mode", heaviest)
+    at = [i for i, g in enumerate(det.signatures)
+          if g.effect == "unmodelled_mode" and g.shape["f_mode"] == heaviest]
+    shape = det.signatures[max(at, key=lambda i: det.z[i])].shape
+    got = dict(zip(names, row))
+    assert all(got[k] == pytest.approx(v) for k, v in shape.items())
+    score = next(c for c in det.candidates if c.effect == "unmodelled_mode")
+    assert got["mass_mode"] == pytest.approx(score.strength)
+
+
 def _screened(effect, bound, failed=False):
     from harvester.diagnosis.screen import Screened
     return Screened(effect, (), np.zeros(1), 0.0, bound, bound + 30.0, failed, 0, 0.0)
