@@ -457,7 +457,13 @@ def test_a_failed_fit_is_ruled_out_only_by_a_trusted_importance_estimate():
     # nor once another candidate is accepted
     from types import SimpleNamespace
     mode = SimpleNamespace(effect="unmodelled_mode", accepted=True)
+
+    def estimate():
+        raise AssertionError("estimated after another candidate was accepted")
+
+    stop.pending = estimate  # neither estimated nor sampled: the next round screens it again
     assert "unmodelled_mode was accepted" in skip_reason(stop, [mode], cs, 3)
+    stop.pending = None
     stop.importance = ImportanceEstimate(4035.0, 0.3, 0.5, 200.0, 1000)
     stop.importance_gain, stop.importance_gain_se = -360.0, 0.3
     assert skip_reason(stop, [], cs, 3) is None  # not trusted: sampled

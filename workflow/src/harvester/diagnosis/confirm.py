@@ -585,8 +585,8 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     already costs) is ruled out by a trusted importance-sampling estimate alone, which does
     not rest on the fit; in a round opened by single effects' scores (``single_scores``: the
     family's test not significant, no conflict), or once another candidate was accepted, such
-    a candidate is not sampled at all: nothing supports it, and its sampling is where stiff
-    contacts spend an hour. None: sample it (always where it was not screened)."""
+    a candidate is neither estimated nor sampled: nothing supports it, and its sampling is
+    where stiff contacts spend an hour. None: sample it (always where it was not screened)."""
     if screened is None:
         return None
     if top is not None and len(results) >= top:
@@ -594,17 +594,17 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     least = settings.base_threshold + settings.mc_sigmas * float(np.hypot(nested_se,
                                                                           BRIDGE_MIN_SE))
     if screened.failed:  # its bound means nothing; a trusted estimate still does
-        ceiling = screened.importance_ceiling(settings.mc_sigmas)
-        if ceiling is not None and ceiling < least:
-            return (f"its fit fell below the nested model's; {screened.importance_phrase()}, "
-                    f"at most {ceiling:.1f}, below the acceptance threshold {least:.1f}")
         if single_scores:
             return ("its fit fell below the nested model's, and the round was opened by single "
                     "effects' scores, not by the family's test")
         accepted = [r.effect for r in results if r.accepted]
-        if accepted:
+        if accepted:  # not estimated either (100 s for a stiff contact): the next round
             return (f"its fit fell below the nested model's and {accepted[0]} was accepted; "
-                    f"{screened.importance_phrase()}: its evidence is not known")
+                    "the next round screens it again")
+        ceiling = screened.importance_ceiling(settings.mc_sigmas)
+        if ceiling is not None and ceiling < least:
+            return (f"its fit fell below the nested model's; {screened.importance_phrase()}, "
+                    f"at most {ceiling:.1f}, below the acceptance threshold {least:.1f}")
         return None
     if screened.bound < least:
         return (f"its best fit gains at most {screened.bound:.1f} nats of evidence, below the "
