@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from harvester.diagnosis.detect import DetectionSettings, data_estimate, prior_conflicts
-from harvester.diagnosis.rank import RankedCandidate, to_confirm
+from harvester.diagnosis.rank import RankedCandidate, rivals, to_confirm
 from harvester.inference.priors import PriorSpec
 from harvester.diagnosis.run import decide_verdict
 from harvester.diagnosis.signatures import candidate_terms
@@ -26,6 +26,19 @@ def test_verdict_needs_evidence_or_a_strong_unexplained_detection():
 def _ranked(effect, p, dchi2, similar=()):
     score = SimpleNamespace(p_value=p)
     return RankedCandidate(effect, score, dchi2, 0.0, 1.0, list(similar))
+
+
+def test_an_open_round_fits_every_rival_whose_score_points_towards_it():
+    # the hardening spring of the literature generator: a mass error scored p 0.03 and a
+    # cubic spring only z 1.4 (delta_chi2 2.0), yet the spring's fit gained 521 nats to 199
+    detection = SimpleNamespace(alpha=0.05, conflict=False)
+    ranked = [_ranked("unmodelled_mode", 0.008, 13.6), _ranked("inertia_error", 0.035, 6.2),
+              _ranked("cubic_stiffness", 0.16, 2.0), _ranked("end_stop", 0.29, 1.7),
+              _ranked("stribeck_friction", 0.41, 0.9)]
+    chosen = to_confirm(ranked, detection, top=6)
+    assert [r.effect for r in chosen] == ["unmodelled_mode", "inertia_error"]
+    assert [r.effect for r in rivals(ranked, chosen)] == ["cubic_stiffness", "end_stop"]
+    assert rivals(ranked, ranked) == []
 
 
 def test_candidates_similar_to_a_chosen_one_are_sampled_too():
