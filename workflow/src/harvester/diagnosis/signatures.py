@@ -80,6 +80,10 @@ def dissipative_force(base_acc: np.ndarray, rel_vel: np.ndarray, m: float) -> fl
     return power / sigma_v
 
 
+#: Quantiles of |z| a device's scale records (1.0: the largest).
+Z_QUANTILES = (0.5, 0.75, 0.9, 0.97, 0.99, 0.999, 1.0)
+
+
 def motion_scale(state: BaselineState, window: tuple[int, int], f_high: float) -> DeviceScale:
     """The device's scales (``DeviceScale``) from the baseline's simulated motion over the
     window, its known (or estimated) masses and spring, and the analysed band."""
@@ -97,8 +101,7 @@ def motion_scale(state: BaselineState, window: tuple[int, int], f_high: float) -
                        v=float(np.sqrt(np.mean(v**2))) or 1e-3,
                        z=float(np.sqrt(np.mean(zc**2))) or 1e-3, f_high=f_high,
                        M=masses["M"], m=masses["m"], k=masses["k"],
-                       z_quantiles={q: float(np.quantile(az, q)) for q in (0.5, 0.75, 0.9,
-                                                                           0.97)})
+                       z_quantiles={q: float(np.quantile(az, q)) for q in Z_QUANTILES})
 
 
 def candidate_terms(structure_terms: tuple[str, ...], allowed: tuple[str, ...] | None = None
