@@ -398,7 +398,9 @@ def test_a_candidate_is_sampled_unless_its_evidence_bound_rules_it_out():
     cs = ConfirmSettings()  # acceptance at log(20) = 3.0 nats plus two standard errors
     assert skip_reason(None, [], cs, 3) is None                      # not screened: sampled
     assert skip_reason(_screened("end_stop", 2.0), [], cs, 3) is not None   # cannot pass
-    assert skip_reason(_screened("end_stop", 2.0, failed=True), [], cs, 3) is None
+    # a failed fit's bound means nothing: its importance estimate decides (test below)
+    assert "nothing supports it" in skip_reason(_screened("end_stop", 2.0, failed=True), [],
+                                                cs, 3)
     best = [_result("hysteresis", 400.0, se=0.5)]
     # a rival whose best fit cannot reach the accepted gain minus the naming margin
     assert "hysteresis gained 400.0" in skip_reason(_screened("unmodelled_mode", 390.0), best,
@@ -446,12 +448,12 @@ def test_a_trusted_importance_estimate_rules_out_what_the_bound_cannot():
     assert skip_reason(mode, [], cs, 3) is None
 
 
-def test_a_failed_fit_is_ruled_out_only_by_a_trusted_importance_estimate():
+def test_a_failed_fit_is_sampled_only_where_a_trusted_importance_estimate_leaves_it_open():
     from harvester.diagnosis.confirm import ConfirmSettings, skip_reason
     from harvester.inference.importance import ImportanceEstimate
     cs = ConfirmSettings()
     stop = _screened("backlash", -300.0, failed=True)  # its bound means nothing
-    assert skip_reason(stop, [], cs, 3) is None
+    assert "nothing supports it" in skip_reason(stop, [], cs, 3)  # and no estimate either
     # in a round the family's test did not open, nothing supports it
     assert "single effects' scores" in skip_reason(stop, [], cs, 3, single_scores=True)
     # nor once another candidate is accepted
@@ -466,6 +468,8 @@ def test_a_failed_fit_is_ruled_out_only_by_a_trusted_importance_estimate():
     stop.pending = None
     stop.importance = ImportanceEstimate(4035.0, 0.3, 0.5, 200.0, 1000)
     stop.importance_gain, stop.importance_gain_se = -360.0, 0.3
-    assert skip_reason(stop, [], cs, 3) is None  # not trusted: sampled
+    assert "nothing supports it" in skip_reason(stop, [], cs, 3)  # not trusted
     stop.importance_trusted = True
-    assert "fell below the nested model's" in skip_reason(stop, [], cs, 3)
+    assert "at most" in skip_reason(stop, [], cs, 3)  # trusted, and it rules the fit out
+    stop.importance_gain = 12.0  # trusted, and the optimiser had missed: sampled
+    assert skip_reason(stop, [], cs, 3) is None

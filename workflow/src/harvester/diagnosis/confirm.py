@@ -582,11 +582,12 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     the naming margin (log(1/alpha) + mc_sigmas standard errors of that gain): it can then
     neither be accepted nor tie with the best. A candidate whose fit failed (fell below the
     nested model's: an optimiser that missed, or an effect whose smallest admissible size
-    already costs) is ruled out by a trusted importance-sampling estimate alone, which does
-    not rest on the fit; in a round opened by single effects' scores (``single_scores``: the
-    family's test not significant, no conflict), or once another candidate was accepted, such
-    a candidate is neither estimated nor sampled: nothing supports it, and its sampling is
-    where stiff contacts spend an hour. None: sample it (always where it was not screened)."""
+    already costs) is sampled only where a trusted importance-sampling estimate, which does
+    not rest on the fit, leaves it open: nothing else supports it, and its sampling is where
+    stiff contacts spend a quarter of an hour (the backlash on the literature grid, never
+    accepted). In a round opened by single effects' scores (``single_scores``: the family's
+    test not significant, no conflict), or once another candidate was accepted, it is not
+    even estimated. None: sample it (always where it was not screened)."""
     if screened is None:
         return None
     if top is not None and len(results) >= top:
@@ -602,7 +603,10 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
             return (f"its fit fell below the nested model's and {accepted[0]} was accepted; "
                     "the next round screens it again")
         ceiling = screened.importance_ceiling(settings.mc_sigmas)
-        if ceiling is not None and ceiling < least:
+        if ceiling is None:
+            return (f"its fit fell below the nested model's and {screened.importance_phrase()}"
+                    ": nothing supports it (the next round screens it again)")
+        if ceiling < least:
             return (f"its fit fell below the nested model's; {screened.importance_phrase()}, "
                     f"at most {ceiling:.1f}, below the acceptance threshold {least:.1f}")
         return None
