@@ -3,9 +3,8 @@
 Each round detects and locates the mismatch of the current structure (``detect``), ranks the
 library's effects by how much of it each explains (``rank``), fits the best ``screen`` of them
 and their rivals (``rank.rivals``) by MAP for a bound on the evidence each can gain
-(``screen``), samples the best few by that
-bound by TMCMC, skipping those the bound rules out, judges them by evidence (``confirm``),
-and adopts the best accepted one. It stops when
+(``screen``), samples the best few by that bound by TMCMC, skipping those the bound rules
+out, judges them by evidence (``confirm``), and adopts the best accepted one. It stops when
 nothing is detected, nothing is worth sampling, nothing sampled is accepted, or after
 ``settings.rounds`` additions.
 """

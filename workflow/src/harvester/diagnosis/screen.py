@@ -372,8 +372,6 @@ def scanned_start(row: np.ndarray, names: list[str], specs: Mapping[str, PriorSp
     score = next((c for c in detection.candidates if c.effect == effect), None)
     start = {**sig.shape, sig.strength: score.strength if score and score.strength > 0
              else sig.amount}
-    for key, v in start.items():
+    for key, v in start.items():  # fit_map's start moves a bound value just inside
         if key in names:
-            lo, hi = (float(b) if b is not None else s * np.inf
-                      for b, s in ((specs[key].lower, -1.0), (specs[key].upper, 1.0)))
-            row[names.index(key)] = min(max(v, lo + 1e-6 * abs(lo)), hi - 1e-6 * abs(hi))
+            row[names.index(key)] = np.clip(v, specs[key].lower, specs[key].upper)
