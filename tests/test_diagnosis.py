@@ -409,6 +409,34 @@ def test_a_candidate_is_sampled_unless_its_evidence_bound_rules_it_out():
     assert skip_reason(_screened("inertia_error", 398.0), best * 3, cs, 3) is not None  # top
 
 
+def test_acceptance_shares_alpha_among_the_candidates_the_round_could_name():
+    # effect-free record s7 of the literature grid: an offset force gained +3.41 nats, over
+    # the per-candidate threshold 3.3, in a round that could have named any of 11 effects
+    from types import SimpleNamespace
+
+    from harvester.diagnosis.confirm import ConfirmSettings, judge, skip_reason
+    from harvester.inference.priors import PriorSpec
+
+    one, family = ConfirmSettings(), ConfirmSettings(family=11)
+    assert family.acceptance_base == pytest.approx(np.log(11 / 0.05))
+    assert family.base_threshold == one.base_threshold == pytest.approx(np.log(20.0))
+    prior = PriorSpec("F_offset", 0.0, 1.0, "N", lower=-np.inf)
+    samples = np.random.default_rng(0).normal(0.0, 0.1, (400, 1))
+
+    def fit(log_evidence):
+        return SimpleNamespace(log_evidence=log_evidence, log_evidence_se=0.05, names=["F_offset"],
+                               priors={"F_offset": prior}, samples=samples)
+
+    base = fit(0.0)
+    assert judge("offset_force", fit(3.41), base, one).accepted
+    assert not judge("offset_force", fit(3.41), base, family).accepted
+    assert judge("offset_force", fit(6.0), base, family).accepted
+    # a screened candidate that cannot reach the family's threshold is not sampled
+    assert skip_reason(_screened("offset_force", 4.5), [], one, 3) is None
+    assert "below the acceptance threshold 5.7" in skip_reason(_screened("offset_force", 4.5),
+                                                               [], family, 3)
+
+
 def test_a_candidate_piled_where_it_stands_for_another_term_brings_that_term_in():
     # Karnopp's stick on the literature generator: the Dahl term's pre-sliding displacement
     # piled at its lower bound, where the law is Coulomb's

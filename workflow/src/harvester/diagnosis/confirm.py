@@ -8,8 +8,12 @@ not inflated by the correlation of the low-passed residuals.
 
 Acceptance. For data from the baseline, the Bayes factor B of any alternative has
 E[B] = 1 (over the baseline's prior predictive), so P(B > 1/alpha) <= alpha (Markov's
-inequality): a candidate is accepted when delta log evidence exceeds log(1/alpha) (3.0 nats at
-alpha = 0.05) plus ``mc_sigmas`` Monte Carlo standard errors of the difference. Each evidence
+inequality). A round compares the family of N candidates the library offers the structure, and
+the union bound gives P(any B_k > N/alpha) <= alpha: a candidate is accepted when delta log
+evidence exceeds log(N/alpha) (5.4 nats for the tanh model's 11 candidates at alpha = 0.05;
+``ConfirmSettings.acceptance_base``) plus ``mc_sigmas`` Monte Carlo standard errors of the
+difference. Which of the N are sampled depends on the data, so the bound holds only over all N,
+not over the few sampled. Each evidence
 is TMCMC's re-estimated by bridge sampling from the final population (``bridge_evidence``),
 whose standard error is its own; chains that disagree by more than ``agreement_nats`` are
 sampled again with twice the particles. Naming (``mark_ties``): the best accepted candidate is
@@ -100,6 +104,10 @@ class ConfirmSettings(TMCMCSettings):
     agreement_nats, enlargements: the chains of a model must agree within agreement_nats;
     where they do not, the model is sampled again with twice the particles, at most
     ``enlargements`` times, and the fit says so (``ModelFit.enlarged``).
+
+    family: the number of candidates the round could name (its acceptance shares alpha among
+    them, ``acceptance_base``). With 1 (per candidate), an effect-free record of the literature
+    grid named an offset force at +3.4 nats against a threshold of 3.3, among 11 candidates.
     """
 
     particles: int = 300
@@ -118,9 +126,18 @@ class ConfirmSettings(TMCMCSettings):
         sampler = {name: getattr(self, name) for name in TMCMCSettings.__dataclass_fields__}
         return TMCMCSettings(**sampler | {"seed": self.seed + offset})
 
+    family: int = 1
+
     @property
     def base_threshold(self) -> float:
+        """log(1/alpha): the Bayes factor by which one named model must beat another."""
         return float(np.log(1.0 / self.alpha))
+
+    @property
+    def acceptance_base(self) -> float:
+        """log(family/alpha): the Bayes factor by which a candidate must beat the nested model
+        when any of ``family`` candidates could have been named (the union bound)."""
+        return float(np.log(max(self.family, 1) / self.alpha))
 
 
 @dataclass
@@ -577,8 +594,8 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     """Why a screened candidate (``diagnosis.screen.Screened``) need not be sampled: ``top``
     candidates were sampled already, or its evidence bound (``Screened.bound``) or its
     importance-sampling ceiling (``Screened.importance_ceiling``, where trusted) lies below the
-    acceptance threshold (log(1/alpha) plus mc_sigmas times the root sum of squares of the
-    nested model's standard error and BRIDGE_MIN_SE), or below the best accepted gain minus
+    acceptance threshold (``acceptance_base`` plus mc_sigmas times the root sum of squares of
+    the nested model's standard error and BRIDGE_MIN_SE), or below the best accepted gain minus
     the naming margin (log(1/alpha) + mc_sigmas standard errors of that gain): it can then
     neither be accepted nor tie with the best. A candidate whose fit failed (fell below the
     nested model's: an optimiser that missed, or an effect whose smallest admissible size
@@ -592,8 +609,8 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
         return None
     if top is not None and len(results) >= top:
         return f"the round's {top} best by their fits were sampled"
-    least = settings.base_threshold + settings.mc_sigmas * float(np.hypot(nested_se,
-                                                                          BRIDGE_MIN_SE))
+    least = settings.acceptance_base + settings.mc_sigmas * float(np.hypot(nested_se,
+                                                                           BRIDGE_MIN_SE))
     if screened.failed:  # its bound means nothing; a trusted estimate still does
         if single_scores:
             return ("its fit fell below the nested model's, and the round was opened by single "
@@ -632,11 +649,11 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
 
 def decisions(baseline: ModelFit, results: list[CandidateResult], settings: ConfirmSettings
               ) -> tuple[float, ...]:
-    """Log evidences at which a candidate's fate changes: acceptance over the baseline, and
-    a tie with (or a lead over) the best accepted so far (``mark_ties``), each by
-    log(1/alpha)."""
-    step = float(np.log(1.0 / settings.alpha))
-    points = [baseline.log_evidence + step]
+    """Log evidences at which a candidate's fate changes: acceptance over the baseline (by
+    ``acceptance_base``), and a tie with (or a lead over) the best accepted so far
+    (``mark_ties``, by log(1/alpha))."""
+    step = settings.base_threshold
+    points = [baseline.log_evidence + settings.acceptance_base]
     accepted = [r.fit.log_evidence for r in results if r.accepted]
     if accepted:
         points += [max(accepted) - step, max(accepted) + step]
@@ -646,11 +663,12 @@ def decisions(baseline: ModelFit, results: list[CandidateResult], settings: Conf
 def judge(effect: str, fit: ModelFit, baseline: ModelFit, settings: ConfirmSettings
           ) -> CandidateResult:
     """The candidate's evidence against the baseline and its acceptance: delta log evidence
-    above log(1/alpha) + mc_sigmas standard errors, and no added parameter piled against a
-    bound of its prior (then the prior cut off what the data wanted: flagged, not trusted)."""
+    above the threshold, and no added parameter piled against a
+    bound of its prior (then the prior cut off what the data wanted: flagged, not trusted).
+    The threshold is ``acceptance_base`` (log(family/alpha)) plus mc_sigmas standard errors."""
     delta = fit.log_evidence - baseline.log_evidence
     se = float(np.hypot(fit.log_evidence_se, baseline.log_evidence_se))
-    threshold = settings.base_threshold + settings.mc_sigmas * se
+    threshold = settings.acceptance_base + settings.mc_sigmas * se
     edges = {}
     for name in term(effect).parameter_names:
         j = fit.names.index(name)
