@@ -17,8 +17,8 @@ not over the few sampled. Each evidence
 is TMCMC's re-estimated by bridge sampling from the final population (``bridge_evidence``),
 whose standard error is its own; chains that disagree by more than ``agreement_nats`` are
 sampled again with twice the particles. Naming (``mark_ties``): the best accepted candidate is
-named only if every physically different rival trails it by more than the acceptance
-threshold plus its Monte Carlo margin; otherwise they are reported together as a tie.
+named only if every physically different rival trails it by more than log(1/alpha) plus its
+Monte Carlo margin; otherwise they are reported together as a tie.
 
 Priors of the added terms: each parameter's prior as its term file states it, in the
 device's own scales (``harvester.model.priors``: the damping force the motion shows, its RMS
@@ -692,8 +692,8 @@ def becomes(result: CandidateResult, effect: str) -> bool:
 def mark_ties(results: list[CandidateResult], settings: ConfirmSettings) -> None:
     """The best accepted candidate is named alone only if every physically different
     candidate (``harvester.model.terms.same_physics``; not one piled at the bound where it
-    becomes the best's term, :func:`becomes`) trails it by more than the acceptance
-    threshold (log(1/alpha) plus mc_sigmas standard errors of the gap); the others within it
+    becomes the best's term, :func:`becomes`) trails it by more than the naming margin
+    (log(1/alpha) plus mc_sigmas standard errors of the gap: two named models, no family); the others within it
     are recorded as indistinguishable from it, both ways. ``results`` best first."""
     accepted = [r for r in results if r.accepted]
     if not accepted:
