@@ -18,6 +18,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+import numpy as np
+
 #: The generators a grid may name (config ``detection.grids.<grid>.generator``).
 GENERATORS = ("library", "literature")
 #: The literature generator's effect-free scenario.
@@ -58,8 +60,11 @@ def literature_refit(made) -> float:
     fs = 1.0 / float(rec["time"].iloc[1] - rec["time"].iloc[0])
     lead, hold, _ = analysis_window(len(rec), fs, LEAD_IN_S,
                                     DiagnosisSettings().holdout_fraction)
-    return refit_unabsorbed(rec, made.clean_rel_acc, made.baseline_rel_acc, made.sidecar,
-                            float(made.truth["noise_rms_rel_acc"]), window=(lead, hold))
+    dev = made.truth["device"]  # the device's own tanh parameters: a start for the refits
+    start = np.array([dev["c"], dev["F_c"], 1.0 / dev["v_t"]])
+    return refit_unabsorbed(rec, made.input_contribution, made.sidecar,
+                            float(made.truth["noise_rms_rel_acc"]), window=(lead, hold),
+                            start=start)
 
 
 def _literature(effect, ratio, seed, settings, csv_path, truth_path):
