@@ -57,7 +57,9 @@ contribution jumps with the strength). Shapes are drawn per seed from the stated
 shape (then a device) whose effect cannot reach the ratio within the strength's physical
 bounds is drawn again, so shapes follow their ranges conditioned on reachability. The truth
 also gives the contribution's RMS left after the tanh baseline's (c, F_c, v_t) absorb what they
-can by linearised least squares (``unabsorbed_to_noise``).
+can by linearised least squares (``unabsorbed_to_noise``), and how far the contribution moves
+when the device is driven by the recorded base acceleration instead of the true one
+(``input_driven_to_clean_contribution``, :func:`recorded_input_contribution`).
 
 Excitation (:func:`draw_excitation`): random-phase multisine, flat over 0.25-0.6 x to 2-5 x
 f_n, with a slow sinusoidal envelope and a 0.5 s raised-cosine fade-in from rest. Integration
