@@ -28,6 +28,7 @@ block by block without building the trajectories: what the likelihood of eq. (10
 
 from __future__ import annotations
 
+import functools
 import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -169,8 +170,11 @@ def _checked_params(layout: Layout, params: np.ndarray) -> tuple[np.ndarray, np.
     return p, valid
 
 
+@functools.lru_cache(maxsize=64)
 def _filter(spec: tuple[float, int] | None, fs: float) -> tuple[np.ndarray, int]:
-    """Rows of a zero-phase Butterworth low-pass (cut-off Hz, order) at fs, or no filter."""
+    """Rows of a zero-phase Butterworth low-pass (cut-off Hz, order) at fs, or no filter;
+    designed once per (spec, fs): the design cost 3.4 ms of a one-particle likelihood call's
+    8.6 ms, which is how ``pm.sample_smc`` calls it. The rows are shared: read them only."""
     if spec is None:
         return acquisition.NO_FILTER, 0
     return acquisition.filter_rows(butterworth_sos(fs, spec[0], int(spec[1])))
