@@ -120,13 +120,12 @@ class ConfirmSettings(TMCMCSettings):
     mc_sigmas: float = 2.0
     bridge: bool = True
     reference: bool = True
+    family: int = 1
 
     def tmcmc(self, offset: int = 0) -> TMCMCSettings:
         """The sampler's settings alone, the seed moved by ``offset``."""
         sampler = {name: getattr(self, name) for name in TMCMCSettings.__dataclass_fields__}
         return TMCMCSettings(**sampler | {"seed": self.seed + offset})
-
-    family: int = 1
 
     @property
     def base_threshold(self) -> float:
@@ -663,9 +662,9 @@ def decisions(baseline: ModelFit, results: list[CandidateResult], settings: Conf
 def judge(effect: str, fit: ModelFit, baseline: ModelFit, settings: ConfirmSettings
           ) -> CandidateResult:
     """The candidate's evidence against the baseline and its acceptance: delta log evidence
-    above the threshold, and no added parameter piled against a
-    bound of its prior (then the prior cut off what the data wanted: flagged, not trusted).
-    The threshold is ``acceptance_base`` (log(family/alpha)) plus mc_sigmas standard errors."""
+    above ``acceptance_base`` (log(family/alpha)) plus mc_sigmas standard errors, and no added
+    parameter piled against a bound of its prior (then the prior cut off what the data wanted:
+    flagged, not trusted)."""
     delta = fit.log_evidence - baseline.log_evidence
     se = float(np.hypot(fit.log_evidence_se, baseline.log_evidence_se))
     threshold = settings.acceptance_base + settings.mc_sigmas * se
@@ -693,8 +692,9 @@ def mark_ties(results: list[CandidateResult], settings: ConfirmSettings) -> None
     """The best accepted candidate is named alone only if every physically different
     candidate (``harvester.model.terms.same_physics``; not one piled at the bound where it
     becomes the best's term, :func:`becomes`) trails it by more than the naming margin
-    (log(1/alpha) plus mc_sigmas standard errors of the gap: two named models, no family); the others within it
-    are recorded as indistinguishable from it, both ways. ``results`` best first."""
+    (log(1/alpha) plus mc_sigmas standard errors of the gap: two named models, no family);
+    the others within it are recorded as indistinguishable from it, both ways. ``results``
+    best first."""
     accepted = [r for r in results if r.accepted]
     if not accepted:
         return

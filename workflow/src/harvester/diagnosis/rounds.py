@@ -88,8 +88,9 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
         scale = rnd.scale = motion_scale(rnd.state, analysis.window, det.frame.f_high)
         effects = [c.effect for c in chosen + rivals(rnd.ranked, chosen)]
         rnd.screen = screen(now.fit, effects, now.priors, scale, det, settings.seed + r)
-        family = replace(settings.confirmation(), family=len(det.candidates))
-        rnd.confirmed = confirm(now.fit, effects, now.priors, family, scale,
+        # the acceptance shares alpha among every candidate the round could name
+        confirmation = replace(settings.confirmation(), family=len(det.candidates))
+        rnd.confirmed = confirm(now.fit, effects, now.priors, confirmation, scale,
                                 seed_offset=1000 * (r + 1), detection=det, screen=rnd.screen,
                                 top=settings.top)
         best = rnd.accepted

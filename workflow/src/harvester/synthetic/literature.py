@@ -1237,7 +1237,7 @@ class GeneratedRecording:
     baseline_rel_acc: np.ndarray = field(repr=False)  # noise-free rel_acc of the device
     #: the contribution as a model driven by the recorded base_acc produces it
     #: (:func:`recorded_input_contribution`)
-    input_contribution: np.ndarray | None = field(default=None, repr=False)
+    input_contribution: np.ndarray = field(repr=False)
 
     def write(self, out_dir: str | Path) -> dict[str, Path]:
         """Write recording.csv, recording.yaml (sidecar) and truth.json atomically."""
