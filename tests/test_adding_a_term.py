@@ -60,10 +60,21 @@ def test_the_walk_through_term_is_listed_by_harvester_terms(new_term, capsys):
 
 def test_the_registry_refuses_the_file_without_its_prior_reasoning(tmp_path):
     code = re.search(r"```python\n(.*?)```", DOC.read_text(), re.S).group(1)
-    bad = re.sub(r',\s*why=("[^"]*"\s*)+', "", code)  # the Prior without its ``why``
-    assert bad != code
+    bad = re.sub(r"\nPriors:\n.*?\n(?=\"\"\")", "\n", code, flags=re.S)  # no reasoning
+    assert bad != code and "Priors:" not in bad
     path = tmp_path / f"{NAME}.py"
     path.write_text(bad)
     with pytest.raises(ValueError, match="why"):
+        load_term_file(path)
+    assert NAME not in TERMS
+
+
+def test_the_registry_refuses_a_prior_reason_for_no_parameter(tmp_path):
+    code = re.search(r"```python\n(.*?)```", DOC.read_text(), re.S).group(1)
+    bad = code.replace("- k_quintic:", "- k_quintc:")
+    assert bad != code
+    path = tmp_path / f"{NAME}.py"
+    path.write_text(bad)
+    with pytest.raises(ValueError, match=r"k_quintc.*not its parameters"):
         load_term_file(path)
     assert NAME not in TERMS

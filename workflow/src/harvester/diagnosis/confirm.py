@@ -114,12 +114,12 @@ class ConfirmSettings(TMCMCSettings):
     chains: int = 2
     proposal_scale: float = 0.8
     mcmc_steps: int = 3
+    bridge: bool = True
+    reference: bool = True
     agreement_nats: float = 1.0
     enlargements: int = 2
     alpha: float = 0.05
     mc_sigmas: float = 2.0
-    bridge: bool = True
-    reference: bool = True
     family: int = 1
 
     def tmcmc(self, offset: int = 0) -> TMCMCSettings:

@@ -81,11 +81,11 @@ class DetectionSettings:
     bootstrap: int = 400
     artifact_components: int = 60
     alpha: float = 0.05
+    conflict_alpha: float = 0.01
     band_fraction: float = BAND_FRACTION
+    window_s: float = 1.0
     gross_region_ratio: float = 1.5
     gross_window_ratio: float = 2.0
-    window_s: float = 1.0
-    conflict_alpha: float = 0.01
     seed: int = 0
 
 

@@ -39,18 +39,18 @@ class DiagnosisSettings:
     recorded.
     """
 
-    particles: int = 300
-    chains: int = 2
+    particles: int = ConfirmSettings.particles
+    chains: int = ConfirmSettings.chains
     seed: int = 0
     rounds: int = 2
     screen: int = 6
     top: int = 3
-    bootstrap: int = 400
-    artifact_components: int = 60
-    alpha: float = 0.05
-    evidence_alpha: float = 0.05
+    bootstrap: int = DetectionSettings.bootstrap
+    artifact_components: int = DetectionSettings.artifact_components
+    alpha: float = DetectionSettings.alpha
+    evidence_alpha: float = ConfirmSettings.alpha
     unexplained_alpha: float = 0.001
-    window_s: float = 1.0
+    window_s: float = DetectionSettings.window_s
     lead_in_s: float = 1.0
     fit_seconds: float | None = None
     holdout_fraction: float = 0.25
@@ -58,9 +58,9 @@ class DiagnosisSettings:
     filter_order: int = 8
     candidates: tuple[str, ...] | None = None
     predictive_samples: int = 100
-    enlargements: int = 2
+    enlargements: int = ConfirmSettings.enlargements
     figures: bool = True
-    reference_start: bool = True
+    reference_start: bool = ConfirmSettings.reference
     denoise_input: bool = True
 
     @classmethod

@@ -23,13 +23,13 @@ class TMCMCSettings:
 
     particles: int = 1000
     chains: int = 4
-    seed: int = 0
     proposal_scale: float = 0.2
     target_cov: float = 1.0
+    target_accept: float | None = None
     mcmc_steps: int = 2
     max_mcmc_steps: int | None = 30
     correlation_threshold: float = 0.1
-    target_accept: float | None = None
+    seed: int = 0
 
     @classmethod
     def from_config(cls, cfg: Mapping) -> "TMCMCSettings":

@@ -7,12 +7,13 @@ Every structure shares the base equation of motion, eq. (1) of Green et al. (201
 with c_m the translational viscous coefficient (N s/m). A term adds one named effect. Each
 term is one object in one file of this package (``model/terms/<name>.py``, a module-level
 ``TERM``), holding everything about it: its parameters with units and priors (written in the
-device's own scales, ``harvester.model.priors``, so that they travel to any device), its
-equation, its force law (plain arithmetic that ``harvester.model.codegen`` compiles into each
-structure's kernel), the bound on its stiffness that sets the integrator's step, its probe
-(how the diagnosis switches a little of it on to see its signature) and its description. The
-registry (:data:`TERMS`) collects every module of the package and refuses a term that lacks
-any of these (:func:`register`); ``docs/adding-a-term.md`` walks through adding one.
+device's own scales, ``harvester.model.priors``, so that they travel to any device; why each
+is plausible is the module docstring's last section, ``Priors:``), its equation, its force
+law (plain arithmetic that ``harvester.model.codegen`` compiles into each structure's
+kernel), the bound on its stiffness that sets the integrator's step, its probe (how the
+diagnosis switches a little of it on to see its signature) and its description. The registry
+(:data:`TERMS`) collects every module of the package and refuses a term that lacks any of
+these (:func:`register`); ``docs/adding-a-term.md`` walks through adding one.
 
 Sign convention: a positive force opposes positive z or z' (it is added to the left-hand side
 of eq. 1). Kinds of term and the signature of their force law:
@@ -38,7 +39,7 @@ import importlib
 import importlib.util
 import pkgutil
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import ModuleType
 
@@ -57,6 +58,9 @@ Z_PER_V = 1.0 / (2.0 * np.pi * 0.5)
 Z_BOUND = Z_PER_V * V_BOUND
 
 KINDS = ("screw", "mass", "inertia", "mode", "coupling")
+
+#: The heading of a term module's docstring section that gives each prior's reasoning.
+PRIORS_HEADING = "Priors:"
 
 
 @dataclass(frozen=True)
@@ -213,7 +217,8 @@ def check_term(t: Term) -> None:
     for p in t.parameters:
         if not p.unit or not p.description or not isinstance(p.prior, Prior) or not p.prior.why:
             problems.append(f"parameter {p.name} needs a unit, a description and a Prior with "
-                            "its reasoning (why)")
+                            f"its reasoning (why: an entry of the module docstring's "
+                            f"{PRIORS_HEADING} section)")
             continue
         try:
             p.prior_on()
@@ -252,15 +257,55 @@ def register(t: Term) -> Term:
     return t
 
 
+def prior_reasons(doc: str | None, where: str = "") -> dict[str, str]:
+    """The reasoning of each parameter's prior from a module docstring's section that starts
+    with a line ``Priors:`` and runs to the docstring's end: an entry per parameter,
+    ``- name: reasoning``, its continuation lines indented. ``{}`` without the section."""
+    lines = (doc or "").splitlines()
+    heads = [i for i, line in enumerate(lines) if line.strip() == PRIORS_HEADING]
+    if not heads:
+        return {}
+    reasons: dict[str, list[str]] = {}
+    for number, line in enumerate(lines[heads[0] + 1:], heads[0] + 2):
+        text = line.strip()
+        if text.startswith("- ") and ":" in text:
+            name, first = text[2:].split(":", 1)
+            reasons[name.strip().strip("`")] = [first.strip()]
+        elif text and reasons and line.startswith(" "):
+            reasons[list(reasons)[-1]].append(text)
+        elif text:
+            raise ValueError(f"{where}: line {number} of the docstring's {PRIORS_HEADING} "
+                             f"section reads {text[:40]!r}; expected '- <parameter>: "
+                             "<reasoning>' or an indented continuation")
+    return {name: " ".join(parts) for name, parts in reasons.items()}
+
+
+def with_reasons(t: Term, doc: str | None) -> Term:
+    """The term with each prior's ``why`` read from its module docstring (:func:`prior_reasons`);
+    a reason for a parameter the term does not have, or given twice, is an error."""
+    reasons = prior_reasons(doc, t.source or t.name)
+    unknown = sorted(set(reasons) - set(t.parameter_names))
+    twice = sorted(p.name for p in t.parameters if p.name in reasons and p.prior.why)
+    if unknown or twice:
+        raise ValueError(f"physics term {t.name!r} ({t.source}): the docstring's "
+                         f"{PRIORS_HEADING} section names {unknown or twice}, which "
+                         + ("are not its parameters" if unknown else "already have a why="))
+    parameters = tuple(replace(p, prior=replace(p.prior, why=reasons[p.name]))
+                       if p.name in reasons else p for p in t.parameters)
+    return replace(t, parameters=parameters)
+
+
 def _register_module(module: ModuleType, stem: str) -> Term:
-    """Register a term module's ``TERM``, which must be named for the file (``<stem>.py``)."""
+    """Register a term module's ``TERM``, which must be named for the file (``<stem>.py``),
+    with its priors' reasoning from the module docstring (:func:`with_reasons`)."""
     t = getattr(module, "TERM", None)
     if not isinstance(t, Term):
         raise ValueError(f"{module.__file__} defines no TERM (a harvester.model.terms.Term)")
     if t.name != stem:
         raise ValueError(f"{module.__file__} defines the term {t.name!r}; the file must be "
                          f"named for it ({t.name}.py)")
-    return register(t)
+    module.TERM = with_reasons(t, module.__doc__)
+    return register(module.TERM)
 
 
 def _discover() -> None:

@@ -7,6 +7,12 @@ half the difference of the down- and up-going friction, switching over its own t
 velocity v_asym so that it can follow a smooth sliding law as well as a sign law. A refinement
 of a sliding friction law (``SLIDING_FRICTION``). Under motion that is one-sided for long
 stretches it acts as a constant force (``offset_force``) there.
+
+Priors:
+
+- F_asym: either direction may be the stronger; the difference rarely exceeds the damping force
+  the motion shows
+- v_asym: its transition velocity over the same decades as a sliding law's
 """
 
 from __future__ import annotations
@@ -33,15 +39,10 @@ def rate_bound(p: dict, motion: Motion) -> RateBound:
 TERM = Term(
     name="asymmetric_friction", kind="screw",
     parameters=(
-        Parameter("F_asym", "N", Prior(
-            "normal", 0.0, 0.5, "force", lower=None,
-            why="either direction may be the stronger; the difference rarely exceeds the "
-                "damping force the motion shows"),
-            "half the difference of down- and up-going friction"),
-        Parameter("v_asym", "m/s", Prior(
-            "loguniform", 0.01, 3.0, "v",
-            why="its transition velocity over the same decades as a sliding law's"),
-            "transition velocity of the direction-dependent part"),
+        Parameter("F_asym", "N", Prior("normal", 0.0, 0.5, "force", lower=None),
+                  "half the difference of down- and up-going friction"),
+        Parameter("v_asym", "m/s", Prior("loguniform", 0.01, 3.0, "v"),
+                  "transition velocity of the direction-dependent part"),
     ),
     equation="f = F_asym tanh(w / v_asym)^2",
     description="direction-dependent friction (gravity preload on a vertical screw)",

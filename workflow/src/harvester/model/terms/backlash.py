@@ -10,6 +10,12 @@ The contact's damping: without it (a Hunt-Crossley law, damping ~ penetration) t
 rang and chattered; at zero clearance the coupling was an undamped mode, and the
 log-likelihood of a record of the baseline itself fell by thousands at the library's
 stiffness (measured).
+
+Priors:
+
+- gap_backlash: axial play of a ball nut: a micrometre when preloaded to a millimetre when worn
+- k_backlash: the contact's resonance 4-6 x above the analysed band: the recorded z'' cannot
+  tell a stiffer contact (a ball nut's 1e7-1e9 N/m) from it, and each step up costs sub-steps
 """
 
 from __future__ import annotations
@@ -59,17 +65,12 @@ def contact_stiffness(d: DeviceScale) -> float:
 TERM = Term(
     name="backlash", kind="coupling", n_states=2,
     parameters=(
-        Parameter("gap_backlash", "m", Prior(
-            "loguniform", 1e-6, 1e-3,
-            why="axial play of a ball nut: a micrometre when preloaded to a millimetre when worn"),
-            "half dead zone in the screw-nut coupling"),
-        Parameter("k_backlash", "N/m", Prior(
-            "normal", CONTACT_BAND[0] ** 2, 0.5 * CONTACT_BAND[0] ** 2, contact_stiffness,
-            lower=CONTACT_BAND[1] ** 2,
-            why="the contact's resonance 4-6 x above the analysed band: the recorded z'' cannot "
-                "tell a stiffer contact (a ball nut's 1e7-1e9 N/m) from it, and each step up "
-                "costs sub-steps"),
-            "axial contact stiffness of the screw-nut coupling"),
+        Parameter("gap_backlash", "m", Prior("loguniform", 1e-6, 1e-3),
+                  "half dead zone in the screw-nut coupling"),
+        Parameter("k_backlash", "N/m",
+                  Prior("normal", CONTACT_BAND[0] ** 2, 0.5 * CONTACT_BAND[0] ** 2,
+                        contact_stiffness, lower=CONTACT_BAND[1] ** 2),
+                  "axial contact stiffness of the screw-nut coupling"),
     ),
     equation="coupling force F_b = k_backlash dz(d, gap) + c_b d' in contact (compressive "
              "only), c_b at damping ratio 0.5 on m J / (m + J); J r'' = F_b - c_m r' - f(r')",

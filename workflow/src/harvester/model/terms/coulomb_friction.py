@@ -1,4 +1,9 @@
-"""Coulomb (dry) friction: f = F_coulomb sgn(w), sgn regularised as tanh(w / V_EPS)."""
+"""Coulomb (dry) friction: f = F_coulomb sgn(w), sgn regularised as tanh(w / V_EPS).
+
+Priors:
+
+- F_coulomb: a dry friction from a hundredth of the damping force the motion shows to twice it
+"""
 
 from __future__ import annotations
 
@@ -21,10 +26,8 @@ def rate_bound(p: dict, motion: Motion) -> RateBound:
 
 TERM = Term(
     name="coulomb_friction", kind="screw",
-    parameters=(Parameter("F_coulomb", "N", Prior(
-        "loguniform", 0.01, 2.0, "force",
-        why="a dry friction from a hundredth of the damping force the motion shows to twice it"),
-        "Coulomb friction force"),),
+    parameters=(Parameter("F_coulomb", "N", Prior("loguniform", 0.01, 2.0, "force"),
+                          "Coulomb friction force"),),
     equation="f = F_coulomb sgn(w), sgn regularised as tanh(w / 1 mm/s)",
     description="Coulomb (dry) friction", force=force, rate_bound=rate_bound,
     alike=("tanh_friction",),

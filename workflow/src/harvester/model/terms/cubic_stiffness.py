@@ -1,4 +1,12 @@
-"""Hardening (or softening) spring: f = k_cubic z^3 (Duffing)."""
+"""Hardening (or softening) spring: f = k_cubic z^3 (Duffing).
+
+Priors:
+
+- k_cubic: hardening or softening; at the RMS displacement the cubic force is within about the
+  linear spring's (at 3 x it, nine times); softening no further than keeps the tangent stiffness
+  k + 3 k_cubic z^2 positive up to 2.2 x the RMS displacement (97 % of a Gaussian motion):
+  beyond it the recorded device would have buckled
+"""
 
 from __future__ import annotations
 
@@ -24,13 +32,9 @@ def rate_bound(p: dict, motion: Motion) -> RateBound:
 
 TERM = Term(
     name="cubic_stiffness", kind="mass",
-    parameters=(Parameter("k_cubic", "N/m^3", Prior(
-        "normal", 0.0, 1.0, "k/z^2", lower=-SOFTENING_LIMIT,
-        why="hardening or softening; at the RMS displacement the cubic force is within about "
-            "the linear spring's (at 3 x it, nine times); softening no further than keeps the "
-            "tangent stiffness k + 3 k_cubic z^2 positive up to 2.2 x the RMS displacement "
-            "(97 % of a Gaussian motion): beyond it the recorded device would have buckled"),
-        "cubic stiffness coefficient"),),
+    parameters=(Parameter("k_cubic", "N/m^3",
+                          Prior("normal", 0.0, 1.0, "k/z^2", lower=-SOFTENING_LIMIT),
+                          "cubic stiffness coefficient"),),
     equation="f = k_cubic z^3", description="hardening/softening spring",
     force=force, rate_bound=rate_bound,
     probe=Probe("k_cubic", lambda d: 1.0 / d.z**3, signed=True), source=__file__)

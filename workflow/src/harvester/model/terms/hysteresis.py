@@ -25,6 +25,18 @@ moving in the direction s, so after a monotone displacement dx
 exactly (``displacement_update``). The integrator advances h that way, so its relaxation rate
 |w| / delta_hyst, thousands per second for micrometre pre-sliding, does not bound the step;
 the bristle stiffness does, through the mechanics (``rate_bound``).
+
+Priors:
+
+- F_hyst: its saturation force from a hundredth of the damping force the motion shows to twice
+  it
+- delta_hyst: pre-sliding displacements (micrometres in ball screws, bristle stiffnesses of
+  1e4-1e8 N/m in the LuGre literature, up to millimetres in polymer contacts) from 1e-4 of the
+  RMS displacement to the RMS displacement itself. A 1/300 bound cut off a Bouc-Wen contact of 7
+  um at 8.7 mm RMS, which the data told from Coulomb friction by 136 nats
+- c_hyst: from a thousandth of the damping the motion shows, where the law is Dahl's, to a
+  hundred times it: LuGre's critically damped bristles, 2 sqrt(sigma_0 M), reach 10-1000 x a
+  device's viscous damping
 """
 
 from __future__ import annotations
@@ -72,25 +84,12 @@ def rate_bound(p: dict, motion: Motion) -> RateBound:
 TERM = Term(
     name="hysteresis", kind="screw", n_states=1,
     parameters=(
-        Parameter("F_hyst", "N", Prior(
-            "loguniform", 0.01, 2.0, "force",
-            why="its saturation force from a hundredth of the damping force the motion shows "
-                "to twice it"),
-            "saturation force of the pre-sliding branch"),
-        Parameter("delta_hyst", "m", Prior(
-            "loguniform", 1e-4, 1.0, "z",
-            why="pre-sliding displacements (micrometres in ball screws, bristle stiffnesses "
-                "of 1e4-1e8 N/m in the LuGre literature, up to millimetres in polymer "
-                "contacts) from 1e-4 of the RMS displacement to the RMS displacement itself. "
-                "A 1/300 bound cut off a Bouc-Wen contact of 7 um at 8.7 mm RMS, which the "
-                "data told from Coulomb friction by 136 nats"),
-            "pre-sliding displacement F_hyst / (bristle stiffness)"),
-        Parameter("c_hyst", "N s/m", Prior(
-            "loguniform", 1e-3, 100.0, "force/v",
-            why="from a thousandth of the damping the motion shows, where the law is Dahl's, "
-                "to a hundred times it: LuGre's critically damped bristles, 2 sqrt(sigma_0 "
-                "M), reach 10-1000 x a device's viscous damping"),
-            "damping of the bristles while they deflect (LuGre's sigma_1)"),
+        Parameter("F_hyst", "N", Prior("loguniform", 0.01, 2.0, "force"),
+                  "saturation force of the pre-sliding branch"),
+        Parameter("delta_hyst", "m", Prior("loguniform", 1e-4, 1.0, "z"),
+                  "pre-sliding displacement F_hyst / (bristle stiffness)"),
+        Parameter("c_hyst", "N s/m", Prior("loguniform", 1e-3, 100.0, "force/v"),
+                  "damping of the bristles while they deflect (LuGre's sigma_1)"),
     ),
     equation="Dahl / LuGre: h' = (F_hyst / delta_hyst) (w - |w| h / F_hyst), "
              "f = h + c_hyst (w - |w| h / F_hyst)",

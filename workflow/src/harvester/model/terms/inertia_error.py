@@ -1,6 +1,14 @@
 """The effective mass differs from the assumed value (a payload, a rotor inertia mis-stated):
 M -> M + dM, m -> m + m_share dM (eq. 2: M = m + J (2 pi / l)^2). A secondary mode far above
 the band acts the same way; the diagnosis reports the two together.
+
+Priors:
+
+- dM: a mass error of either sign, up to about a third of the effective mass per sd (a forgotten
+  payload, a mis-stated rotor inertia)
+- m_share: between an error of the screw-side inertia (0) and of the payload (1), unbounded:
+  both ends are physical (a rotor error alone is exactly 0, and a bound there made its posterior
+  pile against it), and errors of opposite sign lie beyond them
 """
 
 from __future__ import annotations
@@ -27,20 +35,12 @@ def rate_bound(p: dict, motion: Motion) -> RateBound:
 TERM = Term(
     name="inertia_error", kind="inertia",
     parameters=(
-        Parameter("dM", "kg", Prior(
-            "normal", 0.0, 0.3, "M", lower=None,
-            why="a mass error of either sign, up to about a third of the effective mass per "
-                "sd (a forgotten payload, a mis-stated rotor inertia)"),
-            "error of the assumed effective mass"),
-        Parameter("m_share", "-", Prior(
-            "normal", 0.5, 0.5, lower=None,
-            why="between an error of the screw-side inertia (0) and of the payload (1), "
-                "unbounded: both ends are physical (a rotor error alone is exactly 0, and a "
-                "bound there made its posterior pile against it), and errors of opposite "
-                "sign lie beyond them"),
-            "share of dM on the oscillating mass, which also drives the device (-m y''): "
-            "1 for a payload error, 0 for an error of the screw-side inertia "
-            "J (2 pi / l)^2 alone, below 0 or above 1 when the two errors differ in sign"),
+        Parameter("dM", "kg", Prior("normal", 0.0, 0.3, "M", lower=None),
+                  "error of the assumed effective mass"),
+        Parameter("m_share", "-", Prior("normal", 0.5, 0.5, lower=None),
+                  "share of dM on the oscillating mass, which also drives the device (-m y''): 1 "
+                  "for a payload error, 0 for an error of the screw-side inertia J (2 pi / l)^2 "
+                  "alone, below 0 or above 1 when the two errors differ in sign"),
     ),
     equation="M -> M + dM, m -> m + m_share dM (eq. 2: M = m + J (2 pi / l)^2)",
     description="effective mass differs from the assumed value",

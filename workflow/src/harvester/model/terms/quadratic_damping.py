@@ -1,4 +1,10 @@
-"""Velocity-squared (fluid-like) damping: f = c_quad w |w| (an orifice, air drag)."""
+"""Velocity-squared (fluid-like) damping: f = c_quad w |w| (an orifice, air drag).
+
+Priors:
+
+- c_quad: at the RMS velocity the quadratic force is from a hundredth of the damping force the
+  motion shows to twice it
+"""
 
 from __future__ import annotations
 
@@ -20,11 +26,8 @@ def rate_bound(p: dict, motion: Motion) -> RateBound:
 
 TERM = Term(
     name="quadratic_damping", kind="screw",
-    parameters=(Parameter("c_quad", "N s^2/m^2", Prior(
-        "loguniform", 0.01, 2.0, "force/v^2",
-        why="at the RMS velocity the quadratic force is from a hundredth of the damping force "
-            "the motion shows to twice it"),
-        "quadratic damping coefficient"),),
+    parameters=(Parameter("c_quad", "N s^2/m^2", Prior("loguniform", 0.01, 2.0, "force/v^2"),
+                          "quadratic damping coefficient"),),
     equation="f = c_quad w |w|", description="velocity-squared (fluid-like) damping",
     force=force, rate_bound=rate_bound, probe=Probe("c_quad", lambda d: 1.0 / d.v**2),
     source=__file__)

@@ -7,6 +7,17 @@ the exponent covering the literature's exponential (1) and Gaussian (2) decays; 
 switches over a tenth of the Stribeck velocity, so that the excess is reached at low speed
 whatever the device's scale. A refinement of a sliding friction law (``SLIDING_FRICTION``):
 meaningless without one.
+
+Priors:
+
+- F_stribeck: breakaway exceeds sliding friction by a hundredth to twice the damping force the
+  motion shows
+- v_stribeck: the Stribeck velocity from 1/100 of the RMS velocity to 3 x it: Stribeck
+  velocities span 1e-5 to 1e-1 m/s (Armstrong-Helouvry et al. 1994), and below 1/100 of the RMS
+  velocity (a shaker record's velocity resolution, as for the tanh law's transition) the excess
+  cannot be resolved; above 3 x it, it is viscous-like
+- delta_stribeck: the decay's exponent: 1 (exponential) and 2 (Gaussian) are the literature's
+  forms
 """
 
 from __future__ import annotations
@@ -39,24 +50,12 @@ def rate_bound(p: dict, motion: Motion) -> RateBound:
 TERM = Term(
     name="stribeck_friction", kind="screw",
     parameters=(
-        Parameter("F_stribeck", "N", Prior(
-            "loguniform", 0.01, 2.0, "force",
-            why="breakaway exceeds sliding friction by a hundredth to twice the damping force "
-                "the motion shows"),
-            "excess of breakaway over sliding friction"),
-        Parameter("v_stribeck", "m/s", Prior(
-            "loguniform", 1.0 / 100.0, 3.0, "v",
-            why="the Stribeck velocity from 1/100 of the RMS velocity to 3 x it: Stribeck "
-                "velocities span 1e-5 to 1e-1 m/s (Armstrong-Helouvry et al. 1994), and "
-                "below 1/100 of the RMS velocity (a shaker record's velocity resolution, as "
-                "for the tanh law's transition) the excess cannot be resolved; above 3 x it, "
-                "it is viscous-like"),
-            "Stribeck velocity"),
-        Parameter("delta_stribeck", "-", Prior(
-            "normal", 1.5, 0.5, lower=0.5, upper=3.0,
-            why="the decay's exponent: 1 (exponential) and 2 (Gaussian) are the literature's "
-                "forms"),
-            "exponent of the Stribeck decay"),
+        Parameter("F_stribeck", "N", Prior("loguniform", 0.01, 2.0, "force"),
+                  "excess of breakaway over sliding friction"),
+        Parameter("v_stribeck", "m/s", Prior("loguniform", 1.0 / 100.0, 3.0, "v"),
+                  "Stribeck velocity"),
+        Parameter("delta_stribeck", "-", Prior("normal", 1.5, 0.5, lower=0.5, upper=3.0),
+                  "exponent of the Stribeck decay"),
     ),
     equation="f = F_stribeck exp(-|w / v_stribeck|^delta_stribeck) sgn(w)",
     description="Stribeck effect: friction falls from breakaway as sliding speeds up",

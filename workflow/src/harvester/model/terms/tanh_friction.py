@@ -2,6 +2,15 @@
 
 A smooth sliding friction: F_c is the sliding force (N), 1 / beta (m/s) the velocity over
 which it reverses. beta -> inf is Coulomb friction.
+
+Priors:
+
+- F_c: a sliding friction from a hundredth of the damping force the motion shows to twice it
+  (friction is part of that force)
+- beta: the transition velocity 1 / beta from 3 x the RMS velocity (friction almost viscous) to
+  1/100 of it: below, a recording's velocity resolution (noise x sample time, about 1/100 of the
+  RMS velocity on a shaker record) cannot tell it from a sign law, and each decade costs ten
+  times the integrator's steps
 """
 
 from __future__ import annotations
@@ -26,18 +35,9 @@ def rate_bound(p: dict, motion: Motion) -> RateBound:
 TERM = Term(
     name="tanh_friction", kind="screw",
     parameters=(
-        Parameter("F_c", "N", Prior(
-            "loguniform", 0.01, 2.0, "force",
-            why="a sliding friction from a hundredth of the damping force the motion shows "
-                "to twice it (friction is part of that force)"),
-            "friction force amplitude"),
-        Parameter("beta", "s/m", Prior(
-            "loguniform", 1.0 / 3.0, 100.0, "1/v",
-            why="the transition velocity 1 / beta from 3 x the RMS velocity (friction almost "
-                "viscous) to 1/100 of it: below, a recording's velocity resolution (noise x "
-                "sample time, about 1/100 of the RMS velocity on a shaker record) cannot tell "
-                "it from a sign law, and each decade costs ten times the integrator's steps"),
-            "steepness at velocity reversal"),
+        Parameter("F_c", "N", Prior("loguniform", 0.01, 2.0, "force"), "friction force amplitude"),
+        Parameter("beta", "s/m", Prior("loguniform", 1.0 / 3.0, 100.0, "1/v"),
+                  "steepness at velocity reversal"),
     ),
     equation="f = F_c tanh(beta w)", description="hyperbolic tangent friction (Table 4)",
     force=force, rate_bound=rate_bound, alike=("coulomb_friction",),

@@ -10,6 +10,17 @@ weighed structure): the rigid rest is M - m_2 (and m - drive_base m_2), so that 
 where the part follows the rest, the device is the baseline, and far above the band the mode
 changes nothing. A mass the stated M leaves out is ``inertia_error``; a part on a spring that
 was not weighed is both terms.
+
+Priors:
+
+- f_mode: from a hundredth of the analysed band's upper edge (0.2 Hz in the study's 18 Hz band,
+  0.9 Hz in a 92 Hz one: a compliant mount below the device's own resonance) to four times that
+  edge (far above the band its part moves with the rest)
+- zeta_mode: damping ratios of structural modes (0.5 %) to heavily damped mounts (50 %)
+- mass_mode: a modal mass from a thousandth of the effective mass to half of it (the part that
+  moves on its own spring is smaller than the rigid rest)
+- drive_base: between a mode on the mass (1) and one on the screw side (0), unbounded: a mode on
+  the screw side is exactly 0, and a bound there made its posterior pile against it
 """
 
 from __future__ import annotations
@@ -59,30 +70,16 @@ PROBE_DAMPING = (0.15, 0.02)
 TERM = Term(
     name="unmodelled_mode", kind="mode", n_states=2,
     parameters=(
-        Parameter("f_mode", "Hz", Prior(
-            "loguniform", 0.01, 4.0, "f_high",
-            why="from a hundredth of the analysed band's upper edge (0.2 Hz in the study's 18 "
-                "Hz band, 0.9 Hz in a 92 Hz one: a compliant mount below the device's own "
-                "resonance) to four times that edge (far above the band its part moves with "
-                "the rest)"),
-            "natural frequency of the secondary mode"),
-        Parameter("zeta_mode", "-", Prior(
-            "loguniform", 0.005, 0.5,
-            why="damping ratios of structural modes (0.5 %) to heavily damped mounts (50 %)"),
-            "damping ratio of the secondary mode"),
-        Parameter("mass_mode", "kg", Prior(
-            "loguniform", 0.001, 0.5, "M",
-            why="a modal mass from a thousandth of the effective mass to half of it (the part "
-                "that moves on its own spring is smaller than the rigid rest)"),
-            "modal mass of the secondary mode"),
-        Parameter("drive_base", "-", Prior(
-            "normal", 0.5, 0.5, lower=None,
-            why="between a mode on the mass (1) and one on the screw side (0), unbounded: "
-                "a mode on the screw side is exactly 0, and a bound there made its "
-                "posterior pile against it"),
-            "share of the base acceleration in the mode's drive: 1 for a mode attached "
-            "to the mass (driven by its absolute acceleration x'' = z'' + y''), 0 for "
-            "one on the screw side (a rotor on a flexible coupling, driven by z'')"),
+        Parameter("f_mode", "Hz", Prior("loguniform", 0.01, 4.0, "f_high"),
+                  "natural frequency of the secondary mode"),
+        Parameter("zeta_mode", "-", Prior("loguniform", 0.005, 0.5),
+                  "damping ratio of the secondary mode"),
+        Parameter("mass_mode", "kg", Prior("loguniform", 0.001, 0.5, "M"),
+                  "modal mass of the secondary mode"),
+        Parameter("drive_base", "-", Prior("normal", 0.5, 0.5, lower=None),
+                  "share of the base acceleration in the mode's drive: 1 for a mode attached to the"
+                  " mass (driven by its absolute acceleration x'' = z'' + y''), 0 for one on the "
+                  "screw side (a rotor on a flexible coupling, driven by z'')"),
     ),
     equation="u'' + 2 zeta w_n u' + w_n^2 u = -(z'' + drive_base y''), force on the rigid "
              "rest m_2 (w_n^2 u + 2 zeta w_n u'); M -> M - m_2, m -> m - drive_base m_2",
