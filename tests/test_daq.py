@@ -107,31 +107,16 @@ def test_channel_not_in_metadata(raw) -> None:
         daq.read_raw_record(csv, meta)
 
 
-def test_nan_value(raw) -> None:
+@pytest.mark.parametrize("line, row, message, column", [
+    (7, "0.02343750,nan,3.300000", "NaN", "ai0"),
+    (9, "0.03125000,3.300000,", "empty value", "ai1"),
+    (5, "", "empty row", None),
+    (12, "0.04300000,3.300000,4.100000", "non-uniform time", "time"),
+])
+def test_bad_row_is_named_with_its_line_and_column(raw, line, row, message, column) -> None:
     csv, meta = raw
-    edit_line(csv, 7, "0.02343750,nan,3.300000")
-    with raises_at("NaN", line=7, column="ai0"):
-        daq.read_raw_record(csv, meta)
-
-
-def test_empty_value(raw) -> None:
-    csv, meta = raw
-    edit_line(csv, 9, "0.03125000,3.300000,")
-    with raises_at("empty value", line=9, column="ai1"):
-        daq.read_raw_record(csv, meta)
-
-
-def test_empty_row(raw) -> None:
-    csv, meta = raw
-    edit_line(csv, 5, "")
-    with raises_at("empty row", line=5):
-        daq.read_raw_record(csv, meta)
-
-
-def test_non_uniform_time(raw) -> None:
-    csv, meta = raw
-    edit_line(csv, 12, "0.04300000,3.300000,4.100000")
-    with raises_at("non-uniform time", line=12, column="time"):
+    edit_line(csv, line, row)
+    with raises_at(message, line=line, column=column):
         daq.read_raw_record(csv, meta)
 
 

@@ -16,15 +16,12 @@ import pytest
 
 from harvester.diagnosis import DiagnosisSettings, diagnose, quick_detect
 from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
-from harvester.inference.priors import PriorSpec
 from harvester.synthetic.scenarios import ScenarioSettings, make_scenario
+from test_diagnosis import PRIORS  # the tanh model's priors of the fast suite
 
 pytestmark = [pytest.mark.slow,
               pytest.mark.filterwarnings("ignore::UserWarning", "ignore::RuntimeWarning")]
 
-PRIORS = {"c_m": PriorSpec("c_m", 170.0, 50.0, "N s/m"), "F_c": PriorSpec("F_c", 8.4, 5.0, "N"),
-          "beta": PriorSpec("beta", 100.0, 100.0, "s/m"),
-          "sigma": PriorSpec("sigma", 0.07, 0.03, "m/s^2")}
 
 
 @pytest.fixture(autouse=True)
