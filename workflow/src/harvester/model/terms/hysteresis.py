@@ -32,8 +32,8 @@ Priors:
   it
 - delta_hyst: pre-sliding displacements (micrometres in ball screws, bristle stiffnesses of
   1e4-1e8 N/m in the LuGre literature, up to millimetres in polymer contacts) from 1e-4 of the
-  RMS displacement to the RMS displacement itself. A 1/300 bound cut off a Bouc-Wen contact of 7
-  um at 8.7 mm RMS, which the data told from Coulomb friction by 136 nats
+  RMS displacement to the RMS displacement itself. A 1/300 bound cut off a Bouc-Wen contact
+  of 7 um at 8.7 mm RMS, which the data told from Coulomb friction by 136 nats
 - c_hyst: from a thousandth of the damping the motion shows, where the law is Dahl's, to a
   hundred times it: LuGre's critically damped bristles, 2 sqrt(sigma_0 M), reach 10-1000 x a
   device's viscous damping
