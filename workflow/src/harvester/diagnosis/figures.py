@@ -12,17 +12,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from harvester.data.fileio import atomic_path  # noqa: E402
+from harvester.plots.style import save_figure  # noqa: E402
 
 log = logging.getLogger("harvester.diagnosis")
-
-
-def _save(fig, path: Path) -> Path:
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
-    return path
 
 
 def residual_windows(diag, path: Path) -> Path:
@@ -50,7 +42,7 @@ def residual_windows(diag, path: Path) -> Path:
     bx.axhline(1.0, color="k", lw=0.8)
     bx.set_ylabel("energy / expected")
     bx.set_xlabel("time (s)")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def state_regions(diag, path: Path) -> Path:
@@ -82,7 +74,7 @@ def state_regions(diag, path: Path) -> Path:
         ax.set_ylabel("RMS residual (m/s$^2$)")
         ax.legend(fontsize=8, frameon=False)
     axes[1].set_title("where the residual lives in the motion", fontsize=10)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def frequency_bands(diag, path: Path) -> Path:
@@ -111,7 +103,7 @@ def frequency_bands(diag, path: Path) -> Path:
     ax.set_title("residual spectrum (shaded: bands where the candidates explain significant "
                  "energy)", fontsize=10)
     ax.legend(fontsize=8, frameon=False)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def candidates(diag, path: Path) -> Path:
@@ -141,7 +133,7 @@ def candidates(diag, path: Path) -> Path:
         axes[1].axvline(0, color="k", lw=0.6)
     axes[1].set_xlabel("delta log evidence (nats; bar: acceptance threshold)")
     axes[1].set_title("TMCMC evidence (green: accepted)", fontsize=10)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def before_after(diag, path: Path, seconds: float = 6.0) -> Path:
@@ -164,7 +156,7 @@ def before_after(diag, path: Path, seconds: float = 6.0) -> Path:
                      "3 sd", fontsize=10)
         ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)
     axes[-1].set_xlabel("time (s)")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def added_parameters(diag, path: Path) -> Path | None:
@@ -195,7 +187,7 @@ def added_parameters(diag, path: Path) -> Path | None:
         ax.legend(fontsize=8, frameon=False)
     added = ", ".join(t for t in diag.improved.terms if t not in diag.baseline.terms)
     fig.suptitle(f"added: {added} (posterior histogram, prior curve)", fontsize=10)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 FIGURES = {
