@@ -15,6 +15,9 @@ checked before any work, results appear in ``--out`` only when complete
 directory), and every warning goes to the log and to the output (``run.json`` or
 ``diagnosis.json``'s ``notes``). Exit status: 0 done, 2 bad input (the message names the
 file, the line or column, what was found and what was expected), 1 a bug (traceback).
+
+Each command imports the library it needs inside its function, so that ``harvester --help``
+and a bad argument answer at once instead of after PyMC's import.
 """
 
 from __future__ import annotations

@@ -17,7 +17,9 @@ give on the same recordings with the same settings. The steps, in the order they
   (``inference.unseen``);
 * :func:`diagnose_model`: the diagnosis of one identified model (``harvester.diagnosis``).
 
-:func:`group_settings` gives a group's settings from the config.
+:func:`group_settings` gives a group's settings from the config. The workflow imports this
+module when it parses the rules (``workflow/rules/common.smk``), so each step imports the
+library it needs inside its function: parsing the workflow does not load PyMC.
 """
 
 from __future__ import annotations
