@@ -23,7 +23,6 @@ pytestmark = [pytest.mark.slow,
               pytest.mark.filterwarnings("ignore::UserWarning", "ignore::RuntimeWarning")]
 
 
-
 @pytest.fixture(autouse=True)
 def _quiet():
     logging.getLogger("harvester").setLevel(logging.WARNING)

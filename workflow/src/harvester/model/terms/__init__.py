@@ -266,13 +266,14 @@ def prior_reasons(doc: str | None, where: str = "") -> dict[str, str]:
     if not heads:
         return {}
     reasons: dict[str, list[str]] = {}
+    entry: list[str] | None = None  # the entry that continuation lines extend
     for number, line in enumerate(lines[heads[0] + 1:], heads[0] + 2):
         text = line.strip()
         if text.startswith("- ") and ":" in text:
             name, first = text[2:].split(":", 1)
-            reasons[name.strip().strip("`")] = [first.strip()]
-        elif text and reasons and line.startswith(" "):
-            reasons[list(reasons)[-1]].append(text)
+            entry = reasons[name.strip().strip("`")] = [first.strip()]
+        elif text and entry is not None and line.startswith(" "):
+            entry.append(text)
         elif text:
             raise ValueError(f"{where}: line {number} of the docstring's {PRIORS_HEADING} "
                              f"section reads {text[:40]!r}; expected '- <parameter>: "
