@@ -15,7 +15,9 @@ The verdict is the score (Lagrange multiplier) test family: for each signature g
 candidate effect (``signatures.py``), z = <g_perp, r> / sd with sd from the replicates,
 one-sided for effects whose strength cannot be negative; an effect's statistic is the largest
 z^2 over its shape grid and the family's the largest over effects; its p-value is the share of
-replicates whose largest statistic is at least as large. False alarms on recordings of the
+replicates whose largest statistic is at least as large, or, where fewer than ten replicates
+reach it, the generalised Pareto tail of the replicates (``tail.py``), so that it can fall below
+1 / (bootstrap + 1). False alarms on recordings of the
 baseline itself stay at most alpha = 0.05 over 60 seeds (tests/test_diagnosis_calibration.py).
 
 Locations (``locate.py``): shares of residual energy in time windows and state regions against
@@ -43,6 +45,7 @@ from harvester.diagnosis.baseline import BaselineState
 from harvester.diagnosis.locate import (FrequencyBands, MeasuredStandstill, Standardised,
                                         StateRegions, TimeWindows, standardise)
 from harvester.diagnosis.signatures import Signature, motion_scale, signatures
+from harvester.diagnosis.tail import TailP, tail_p
 from harvester.diagnosis.spectral import (Frame, Metric, Projector, level_envelope,
                                           noise_replicates, removed_input_psd)
 from harvester.inference.priors import PriorSpec
@@ -135,6 +138,7 @@ class Detection:
     p_value: float
     family_p: dict[str, float]
     family_statistic: dict[str, float]
+    family_tail: dict[str, TailP] = field(repr=False)  # how each family's p-value was found
     signatures: list[Signature] = field(repr=False)
     z: np.ndarray = field(repr=False)  # per signature
     absorbed: np.ndarray = field(repr=False)  # (signatures, P): parameter shift per unit strength
@@ -318,19 +322,6 @@ def gated_max(stats: Standardised, log_share_gate: np.ndarray) -> tuple[float, n
     return obs, rep
 
 
-def _rank_p(observed: float, replicates: np.ndarray) -> float:
-    if observed == -np.inf:
-        return 1.0
-    return float((1.0 + np.sum(replicates >= observed)) / (1.0 + replicates.size))
-
-
-def _replicate_p(replicates: np.ndarray) -> np.ndarray:
-    """p-value of each replicate among all replicates (fraction at least as large)."""
-    order = np.sort(replicates)
-    p = (replicates.size - np.searchsorted(order, replicates, side="left")) / replicates.size
-    return np.where(replicates == -np.inf, 1.0, p)
-
-
 @dataclass
 class Whitened:
     """The residual in the detection's frame: weighted by the inverse of its smoothed
@@ -437,7 +428,7 @@ def score_tests(w: Whitened, sigs: SignatureSet, reps: np.ndarray) -> ScoreTests
         g2 = max(sigs.gram[best], 1e-300)
         scores.append(CandidateScore(
             effect=effect, label=sigs.signatures[best].label, index=best, z=float(z[best]),
-            statistic=float(stat[best]), p_value=_rank_p(stat[best], best_reps[-1]),
+            statistic=float(stat[best]), p_value=tail_p(stat[best], best_reps[-1]).p,
             strength=float(s_obs[best] / g2), strength_se=float(sd[best] / g2),
             explained_share=float(s_obs[best] ** 2 / g2 / total)))
     return ScoreTests(z, scores, float(max(c.statistic for c in scores)),
@@ -564,12 +555,13 @@ def detect(state: BaselineState, window: tuple[int, int], priors: Mapping[str, P
     family = dict(located.family)
     if scores.statistic is not None:
         family = {"library": (scores.statistic, scores.replicates), **family}
-    family_p = {f: _rank_p(obs, rep) for f, (obs, rep) in family.items()}
+    family_tail = {f: tail_p(obs, rep, settings.seed) for f, (obs, rep) in family.items()}
+    family_p = {f: t.p for f, t in family_tail.items()}
     shares = band_shares(w, sigs, stationary)
     conflicts = prior_conflicts(problem.parameter_names, state.samples, priors, settings)
     det = Detection(
         frame=w.frame, temper=w.temper, alpha=settings.alpha,
-        p_value=family_p.get("library", 1.0), family_p=family_p,
+        p_value=family_p.get("library", 1.0), family_p=family_p, family_tail=family_tail,
         family_statistic={f: obs for f, (obs, _) in family.items()},
         signatures=sigs.signatures, z=scores.z, absorbed=sigs.absorbed, gram=sigs.gram,
         signature_dft=sigs.projected, metric=w.metric, candidates=scores.candidates,

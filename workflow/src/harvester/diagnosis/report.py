@@ -110,7 +110,8 @@ def _detection(det) -> dict:
     return {"p_value": det.p_value, "alpha": det.alpha, "significant": det.significant,
             "test": "score tests of the candidates' signatures (library family); windows and "
                     "regions are locations, reported with their own calibrated p-values",
-            "families": {f: {"statistic": float(det.family_statistic[f]), "p_value": float(p)}
+            "families": {f: {"statistic": float(det.family_statistic[f]), "p_value": float(p),
+                             "p_value_from": det.family_tail[f].to_dict()}
                          for f, p in det.family_p.items()},
             "band_hz": [det.frame.f_low, det.frame.f_high], "sigma": det.sigma,
             "prior_conflict": det.conflict,
