@@ -35,7 +35,7 @@ from harvester.inference.priors import PriorSpec
 OLD_SIDE = r"""
 import json, sys
 import numpy as np
-from harvester.diagnosis.confirm import candidate_priors
+from harvester.diagnosis.fits import candidate_priors
 from harvester.diagnosis.signatures import MotionScale
 out = []
 for job in json.load(sys.stdin):

@@ -24,7 +24,7 @@ from harvester.data.daq import read_recording
 from harvester.data.fileio import read_json
 from harvester.diagnosis.analysis import default_priors
 from harvester.diagnosis.baseline import chain_problem, fit_map
-from harvester.diagnosis.confirm import candidate_priors
+from harvester.diagnosis.fits import candidate_priors
 from harvester.diagnosis.rank import rank
 from harvester.diagnosis.run import quick_detect
 from harvester.diagnosis.settings import DiagnosisSettings

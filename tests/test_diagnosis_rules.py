@@ -10,7 +10,10 @@ import pytest
 from harvester.diagnosis.detect import DetectionSettings, data_estimate, prior_conflicts
 from harvester.diagnosis.rank import RankedCandidate, rivals, to_confirm
 from harvester.inference.priors import PriorSpec
+from harvester.diagnosis.floor import Floor
 from harvester.diagnosis.run import decide_verdict
+from harvester.diagnosis.settings import DiagnosisSettings
+from harvester.diagnosis.verdict import FitJudgement
 from harvester.diagnosis.signatures import candidate_terms
 
 
@@ -21,6 +24,52 @@ def test_verdict_needs_evidence_or_a_strong_unexplained_detection():
     # an effect confirmed by evidence is enough whatever the screening said (prior conflict)
     assert decide_verdict(0.4, accepted=True, unexplained_alpha=0.001) == "missing_physics"
     assert decide_verdict(0.4, accepted=False, unexplained_alpha=0.001) == "adequate"
+
+
+def test_a_model_that_explains_little_is_inadequate_unless_the_noise_limits_it():
+    # the frame's linear baseline: holdout NRMSE 0.87-1.03, "adequate" before (p at its floor)
+    for share in (0.0, 0.24, 0.49):
+        assert decide_verdict(0.2, False, 0.001, explained=share) == "inadequate"
+        assert decide_verdict(0.2, True, 0.001, explained=share) == "inadequate"
+        # a residual shown to lie at the recording's noise floor: the noise limits the share
+        assert decide_verdict(0.2, False, 0.001, explained=share,
+                              within_floor=True) == "adequate"
+    assert decide_verdict(0.2, False, 0.001, explained=0.9) == "adequate"
+    # a residual far above an independent floor is mismatch, whatever the replicates say
+    assert decide_verdict(0.2, False, 0.001, explained=0.9, above_floor=True) == \
+        "missing_physics"
+
+
+def _judgement(ratio, bound, explained=0.6, improved=None):
+    return FitJudgement(explained, np.sqrt(1 - explained), "holdout", ratio,
+                        Floor(1.0, "repeated_periods", "", bound), improved)
+
+
+def test_a_floor_bound_decides_only_the_side_it_bounds():
+    assert _judgement(5.0, "upper").above(3.0) is True
+    assert _judgement(5.0, "lower").above(3.0) is None  # the true floor may be higher
+    assert _judgement(2.0, "lower").within(3.0) is True
+    assert _judgement(2.0, "upper").within(3.0) is None  # the true floor may be lower
+    assert _judgement(2.0, "estimate").above(3.0) is False
+    assert _judgement(2.0, "upper", 0.2, 0.84).library_share() == pytest.approx(0.8)
+
+
+def test_every_alpha_of_the_settings_is_reachable_at_the_default_settings():
+    """The smallest p-value each verdict's test can give at the default settings lies below
+    its alpha: the detection's p-value at a statistic far out in the replicates' tail (the
+    replicates' count is the default ``bootstrap``), the evidence's by construction."""
+    from harvester.diagnosis.tail import tail_p
+
+    s = DiagnosisSettings()
+    reps = np.max(np.random.default_rng(0).standard_normal((s.bootstrap, 40)) ** 2, axis=1)
+    smallest = tail_p(float(reps.max()) * 3.0, reps).p
+    alphas = {k: v for k, v in s.__dict__.items() if k.endswith("alpha")}
+    assert set(alphas) == {"alpha", "evidence_alpha", "unexplained_alpha"}
+    for name in ("alpha", "unexplained_alpha"):
+        assert smallest < alphas[name], (name, smallest, alphas[name])
+    fast = DiagnosisSettings.fast()
+    reps = reps[:fast.bootstrap]
+    assert tail_p(float(reps.max()) * 3.0, reps).p < fast.unexplained_alpha
 
 
 def _ranked(effect, p, dchi2, similar=()):

@@ -316,7 +316,7 @@ def diagnose_model(data: str | Path, validation: str | Path | None, posterior: s
 def diagnosis_html(doc: Mapping[str, Any], title: str) -> str:
     """The diagnosis in words for the report: verdict, missing effects, the candidates
     sampled with their evidence gain, and the fit before and after on unseen data."""
-    lines = [f"verdict: {doc.get('verdict')}",
+    lines = [f"verdict: {doc.get('headline') or doc.get('verdict')}",
              "missing: " + (", ".join(doc.get("missing") or []) or "nothing")]
     fit = doc.get("fit") or {}
     for which in ("baseline", "improved"):

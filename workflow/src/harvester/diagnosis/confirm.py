@@ -49,13 +49,14 @@ from __future__ import annotations
 import logging
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING
 
-import arviz as az
 import numpy as np
 
 from harvester.diagnosis.baseline import ChainProblem, chain_problem
 from harvester.diagnosis.detect import Detection, at_prior_edge
+from harvester.diagnosis.fits import (BRIDGE_MIN_SE, MISSED_MODE_NATS, ModelFit, candidate_priors,
+                                      prior_dict, scan_factor, support)
+from harvester.diagnosis.screen import Screen
 from harvester.diagnosis.signatures import candidate_terms
 from harvester.model.priors import DeviceScale
 from harvester.inference.evidence import BridgeEstimate, chains_bridge_log_evidence, log_target
@@ -64,22 +65,12 @@ from harvester.inference.posterior import posterior_theta, pooled_log_evidence, 
 from harvester.model.terms import same_physics, term
 from harvester.inference.priors import PriorSpec
 from harvester.inference.priors import priors_for
-from harvester.inference.reference import GaussianFactor, Reference, ScanFactor
+from harvester.inference.reference import GaussianFactor, Reference
 from harvester.model.structures import ModelStructure
-
-if TYPE_CHECKING:
-    from harvester.diagnosis.screen import Screen
 
 log = logging.getLogger("harvester.diagnosis")
 
 
-#: A chain whose log evidence is this far below the best one missed the posterior's mode.
-MISSED_MODE_NATS = 5.0
-#: Smallest Monte Carlo standard error assumed for a pooled log evidence (nats): two chains'
-#: scatter is a poor estimate of it, and the chains may share a bias their errors miss.
-MIN_SE = 0.25
-#: Smallest standard error assumed for a bridge-sampling log evidence (nats).
-BRIDGE_MIN_SE = 0.1
 
 
 @dataclass(frozen=True)
@@ -140,97 +131,6 @@ class ConfirmSettings(TMCMCSettings):
 
 
 @dataclass
-class ModelFit:
-    """A structure sampled by TMCMC under the diagnosis's likelihood."""
-
-    structure: ModelStructure
-    problem: ChainProblem
-    samples: np.ndarray  # rows (free parameters..., sigma)
-    log_evidence_chains: np.ndarray
-    idata: az.InferenceData | None = field(default=None, repr=False)
-    priors: dict[str, PriorSpec] = field(default_factory=dict, repr=False)
-    bridge: BridgeEstimate | None = None
-    reference: Reference | None = None
-    restarted: bool = False  # the reference start collapsed; sampled again from the prior
-    #: (particles, spread of the chains' log evidences) of each run that was enlarged
-    enlarged: list[tuple[int, float]] = field(default_factory=list)
-
-    @property
-    def names(self) -> tuple[str, ...]:
-        return self.problem.parameter_names
-
-    @property
-    def log_evidence(self) -> float:
-        """The bridge-sampling estimate where it was made, else TMCMC's pooled over chains."""
-        return self.bridge.log_evidence if self.bridge else self.tmcmc_log_evidence
-
-    @property
-    def tmcmc_log_evidence(self) -> float:
-        return pooled_log_evidence(self.log_evidence_chains)
-
-    @property
-    def log_evidence_se(self) -> float:
-        """Standard error of ``log_evidence``: the bridge's (at least BRIDGE_MIN_SE), else
-        TMCMC's (:meth:`tmcmc_log_evidence_se`)."""
-        if self.bridge is not None:
-            return float(max(self.bridge.se, BRIDGE_MIN_SE))
-        return self.tmcmc_log_evidence_se
-
-    @property
-    def tmcmc_log_evidence_se(self) -> float:
-        """Monte Carlo standard error of the pooled log evidence: the larger of what the
-        chains state (root sum of their squared errors over the number of chains) and their
-        scatter over the root of their number, from the chains that found the posterior's
-        main mode (within MISSED_MODE_NATS of the best chain); a chain far below missed it,
-        which lowers the pooled value by at most log(chains), and is counted in
-        ``missed_chains`` rather than as scatter. At least MIN_SE."""
-        c = self.log_evidence_chains
-        near = c[c >= c.max() - MISSED_MODE_NATS]
-        scatter = float(np.std(near, ddof=1) / np.sqrt(len(near))) if len(near) > 1 else 0.0
-        stated = self.stated_se_chains
-        stated_se = float(np.sqrt(np.sum(np.square(stated))) / len(stated)) if stated else 0.0
-        return float(max(scatter, stated_se, MIN_SE if len(c) > 1 else 0.0))
-
-    @property
-    def missed_chains(self) -> int:
-        c = self.log_evidence_chains
-        return int(np.sum(c < c.max() - MISSED_MODE_NATS))
-
-    def evidence_dict(self) -> dict:
-        """Both estimates of the log evidence, and which one ``log_evidence`` is."""
-        return {"log_evidence": self.log_evidence, "log_evidence_se": self.log_evidence_se,
-                "log_evidence_method": "bridge" if self.bridge else "tmcmc",
-                "log_evidence_tmcmc": self.tmcmc_log_evidence,
-                "log_evidence_chains": [float(x) for x in self.log_evidence_chains],
-                "chains_missing_the_mode": self.missed_chains,
-                "log_evidence_bridge": self.bridge.to_dict() if self.bridge else None,
-                "log_evidence_se_chains": self.stated_se_chains,
-                "chains_spread": self.chains_spread,
-                "tempered_from": self.reference.describe() if self.reference else None,
-                "restarted_from_prior": self.restarted,
-                "enlarged_after": [{"particles": n, "chains_spread": s}
-                                   for n, s in self.enlarged]}
-
-    @property
-    def chains_spread(self) -> float:
-        """Largest minus smallest of the chains' log evidences (nats)."""
-        c = self.log_evidence_chains
-        return float(np.max(c) - np.min(c)) if len(c) > 1 else 0.0
-
-    @property
-    def stated_se_chains(self) -> list[float]:
-        """Each chain's own stated standard error of its log evidence (TMCMC's)."""
-        if self.idata is None or "log_evidence_se" not in self.idata.sample_stats:
-            return []
-        return [float(x) for x in self.idata.sample_stats["log_evidence_se"].values]
-
-    def summary(self) -> dict[str, dict[str, float]]:
-        return {n: {"mean": float(self.samples[:, j].mean()),
-                    "sd": float(self.samples[:, j].std(ddof=1))}
-                for j, n in enumerate(self.names)}
-
-
-@dataclass
 class CandidateResult:
     """The evidence for one augmented structure against the baseline."""
 
@@ -271,21 +171,6 @@ class CandidateResult:
                 "added_parameters": {n: summ[n] for n in added if n in summ},
                 "added_priors": {n: prior_dict(self.fit.priors[n]) for n in added
                                  if n in self.fit.priors}}
-
-
-def prior_dict(spec: PriorSpec) -> dict:
-    """A prior as diagnosis.json gives it."""
-    return {"family": spec.family, "mean": spec.mean, "sd": spec.sd, "lower": spec.lower,
-            "upper": spec.upper, "unit": spec.unit, "described": spec.describe()}
-
-
-def candidate_priors(effect: str, scale: DeviceScale, known: Mapping[str, float] | None = None
-                     ) -> dict[str, PriorSpec]:
-    """Priors of an added term's parameters on this device: each parameter's prior in the
-    device's scales (its term file, ``harvester.model.priors.Prior``) read on ``scale``.
-    ``known``: accepted for callers that pass the device's known values (``scale`` holds
-    them)."""
-    return {p.name: p.prior_on(scale) for p in term(effect).parameters}
 
 
 def candidate_particles(effect: str, particles: int) -> int:
@@ -351,44 +236,6 @@ def map_reference(point, priors: Mapping[str, PriorSpec]) -> Reference | None:
         log.warning("no Gaussian start at the MAP (%s): tempering from the prior", err)
         return None
     return Reference({n: priors[n] for n in names}, (gaussian,), REFERENCE_SHARE)
-
-
-def scan_factor(effect: str, detection: Detection | None,
-                priors: Mapping[str, PriorSpec]) -> ScanFactor | None:
-    """The candidate's ``Probe.start_shape`` where the detection's scan of it places it:
-    log-normal components at the scanned values, one grid step wide (the median log
-    spacing), weighted by exp(statistic / 2) summed over each value's signatures (the score
-    test's likelihood ratio). None where the effect has no start shape or fewer than 3 values
-    were scanned inside its prior."""
-    probe = term(effect).probe
-    if detection is None or probe.start_shape is None:
-        return None
-    name = probe.start_shape
-    idx = [i for i, sig in enumerate(detection.signatures)
-           if sig.effect == effect and name in sig.shape]
-    values = np.array([detection.signatures[i].shape[name] for i in idx], dtype=float)
-    z = np.asarray(detection.z, dtype=float)[idx]
-    stat = z**2 if probe.signed else np.maximum(z, 0.0) ** 2
-    (lower,), (upper,) = support(priors, (name,))
-    inside = (values > lower) & (values < upper)  # the scan may reach beyond the prior
-    values, stat = values[inside], stat[inside]
-    grid = np.unique(values)
-    if len(grid) < 3:
-        return None
-    half = np.array([np.logaddexp.reduce(0.5 * stat[values == v]) for v in grid])
-    step = float(np.median(np.diff(np.log(grid))))
-    try:
-        return ScanFactor(name, tuple(grid.tolist()), (step,) * len(grid),
-                          tuple(np.exp(half - half.max()).tolist()), lower, upper)
-    except ValueError as err:  # the scan lies outside the prior
-        log.warning("no scan start for %s (%s)", effect, err)
-        return None
-
-
-def support(priors: Mapping[str, PriorSpec], names) -> tuple[tuple[float, ...], ...]:
-    """(lowers, uppers) of the priors of ``names``: where a reference may put particles."""
-    return (tuple(float(priors[n].lower) for n in names),
-            tuple(float(priors[n].upper) for n in names))
 
 
 #: A final TMCMC stage accepting at least this share of its moves had collapsed onto copies
@@ -534,7 +381,7 @@ def start_of(effect: str, baseline: ModelFit, detection: Detection | None,
 
 def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSpec],
             settings: ConfirmSettings, scale: DeviceScale, seed_offset: int = 0,
-            detection: Detection | None = None, screen: "Screen | None" = None,
+            detection: Detection | None = None, screen: Screen | None = None,
             top: int | None = None) -> list[CandidateResult]:
     """Sample each augmented structure; evidence against the baseline; acceptance.
     ``detection``: the round's detection, whose scans place the start of candidates with a

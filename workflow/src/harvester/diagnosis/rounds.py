@@ -18,7 +18,8 @@ import numpy as np
 
 from harvester.diagnosis.analysis import Analysis, BaselineStart
 from harvester.diagnosis.baseline import BaselineState, baseline_state
-from harvester.diagnosis.confirm import CandidateResult, ModelFit, confirm, fit_structure
+from harvester.diagnosis.confirm import CandidateResult, confirm, fit_structure
+from harvester.diagnosis.fits import ModelFit
 from harvester.diagnosis.detect import Detection, detect
 from harvester.diagnosis.rank import RankedCandidate, rank, rivals, to_confirm
 from harvester.diagnosis.screen import Screen, screen

@@ -60,7 +60,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from harvester.diagnosis.baseline import PointFit, PriorCoordinates, chain_problem, fit_map
-from harvester.diagnosis.confirm import ModelFit, candidate_priors, scan_factor
+from harvester.diagnosis.fits import ModelFit, candidate_priors, scan_factor
 from harvester.diagnosis.detect import Detection
 from harvester.inference.importance import (Component, ImportanceEstimate, MixtureProposal,
                                             importance_log_evidence)

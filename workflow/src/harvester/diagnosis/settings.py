@@ -20,7 +20,11 @@ class DiagnosisSettings:
     artifact_components, alpha, window_s: detection (``DetectionSettings``); evidence_alpha:
     acceptance (``ConfirmSettings``); unexplained_alpha: a detection that no library effect
     explains counts as missing physics only below this p-value (an effect confirmed by
-    evidence always does; see ``decide_verdict``); lead_in_s: start of the analysis (the model
+    evidence always does; see ``decide_verdict``); min_explained_share: a baseline that explains
+    less of the unseen output than this share (1 - NRMSE^2) is "inadequate", unless its residual
+    lies within ``floor_ratio`` of the recording's own noise floor (``floor.py``); floor_ratio:
+    a residual RMS above this many times that floor is mismatch whatever the detection says;
+    lead_in_s: start of the analysis (the model
     starts at rest); fit_seconds: most seconds of the recording TMCMC fits (None, the default:
     the whole window the detection analyses, all but the holdout); holdout_fraction: share of
     the recording's end kept unseen when no validation record is given; lowpass_hz: cut-off
@@ -50,6 +54,8 @@ class DiagnosisSettings:
     alpha: float = DetectionSettings.alpha
     evidence_alpha: float = ConfirmSettings.alpha
     unexplained_alpha: float = 0.001
+    min_explained_share: float = 0.5
+    floor_ratio: float = 3.0
     window_s: float = DetectionSettings.window_s
     lead_in_s: float = 1.0
     fit_seconds: float | None = None

@@ -1,6 +1,14 @@
 """What the diagnosis concludes: the verdict, the effects it names, and the ties it cannot
 break.
 
+Three verdicts (``decide_verdict``): "adequate"; "missing_physics" (an effect named by
+evidence, or a mismatch no library effect explains: a detection below ``unexplained_alpha``, or
+a residual far above the recording's own noise floor, ``floor.py``); "inadequate" (the baseline
+leaves most of the unseen output unexplained, whatever the library can name; the headline then
+says whether the library explains the mismatch, part of it or none). The headline (``judge``)
+states the verdict, the share of the unseen output the baseline explains and the noise floor it
+was judged against.
+
 An effect is *named* only when it is accepted by evidence and every physically different
 candidate trails it by more than the acceptance threshold (``confirm.mark_ties``); otherwise
 the verdict lists the tie: what each candidate would mean physically, and which experiment
@@ -11,9 +19,12 @@ than no name.
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
-from harvester.diagnosis.confirm import CandidateResult, ModelFit
+from harvester.diagnosis.confirm import CandidateResult
+from harvester.diagnosis.fits import ModelFit
+from harvester.diagnosis.detect import Detection
+from harvester.diagnosis.floor import Floor
 from harvester.diagnosis.rounds import Round
 from harvester.diagnosis.separate import Separation, separations
 from harvester.diagnosis.settings import DiagnosisSettings
@@ -24,23 +35,86 @@ log = logging.getLogger("harvester.diagnosis")
 TIE_RIVALS = 2
 
 
-def decide_verdict(p_value: float, accepted: bool, unexplained_alpha: float) -> str:
-    """"missing_physics" when an added effect is confirmed by evidence, or when the
-    detection's p-value is below ``unexplained_alpha`` although nothing explains it; else
-    "adequate".
+def decide_verdict(p_value: float, accepted: bool, unexplained_alpha: float, *,
+                   explained: float | None = None, min_explained: float = 0.5,
+                   above_floor: bool | None = None, within_floor: bool | None = None) -> str:
+    """"inadequate" when the baseline explains less than ``min_explained`` of the unseen
+    output (``explained`` = 1 - NRMSE^2) and its residual is not shown to lie at the noise
+    floor (``within_floor``); else "missing_physics" when an added effect is confirmed by
+    evidence, the detection's p-value is below ``unexplained_alpha`` although nothing explains
+    it, or the residual lies far above the recording's own noise floor (``above_floor``);
+    else "adequate".
 
     The detection at ``alpha`` only screens: on data the baseline explains, it fires in about
     alpha of recordings, and a verdict on it alone would cry wolf at that rate. Evidence
     acceptance is calibrated by itself (``confirm``: P(B > 1/alpha) <= alpha under the
     baseline), so the false-alarm rate is at most P(accepted) + unexplained_alpha. The
-    detection's replicate p-value cannot fall below 1 / (bootstrap + 1): the default 0.001
-    needs 1000 replicates, so with fewer the verdict rests on evidence alone. (Measured: on
-    8 s analysed records of the baseline itself, 2 of 5 reached the smallest p-value of 200
-    and 300 replicates: the replicate null is too light-tailed there to trust a lone
-    detection.) Either way ``unexplained_mismatch`` in diagnosis.json reports a significant
-    detection that no effect explains.
+    detection's p-value reaches below 1 / (bootstrap + 1) by its replicates' tail
+    (``tail.py``), so ``unexplained_alpha`` is reachable at any number of replicates. The
+    floor and the share explained do not rest on the replicates, which take the residual's own
+    level: a residual that is the whole signal cannot hide in them.
     """
-    return "missing_physics" if accepted or p_value < unexplained_alpha else "adequate"
+    if explained is not None and explained < min_explained and not within_floor:
+        return "inadequate"
+    if accepted or p_value < unexplained_alpha or above_floor:
+        return "missing_physics"
+    return "adequate"
+
+
+@dataclass(frozen=True)
+class FitJudgement:
+    """How much of the output the baseline explains, and against what noise.
+
+    explained, improved: 1 - NRMSE^2 of the baseline's and the improved model's predictive
+    means on unseen data (``unseen``: "validation" or "holdout"; None without unseen data);
+    residual_rms: the baseline's residual RMS over the analysed window, through the
+    measurement chain (output units); floor: the recording's own noise floor over the same
+    band (``floor.output_floor``, None where the recording shows none).
+    """
+
+    explained: float | None
+    nrmse: float | None
+    unseen: str | None
+    residual_rms: float
+    floor: Floor | None
+    improved: float | None = None
+
+    @property
+    def ratio(self) -> float | None:
+        """residual RMS / floor RMS."""
+        return None if self.floor is None or self.floor.rms <= 0 else \
+            self.residual_rms / self.floor.rms
+
+    def above(self, limit: float) -> bool | None:
+        """The residual is above ``limit`` x the floor, and the floor's estimate cannot be
+        too low for that (an upper bound or an estimate); None where undetermined."""
+        r = self.ratio
+        if r is None or r <= limit or self.floor.bound == "lower":
+            return None if r is None or self.floor.bound == "lower" else False
+        return True
+
+    def within(self, limit: float) -> bool | None:
+        """The residual is within ``limit`` x the floor, and the floor's estimate cannot be
+        too high for that (a lower bound or an estimate); None where undetermined."""
+        r = self.ratio
+        if r is None or self.floor.bound == "upper":
+            return None
+        return bool(r <= limit)
+
+    def library_share(self) -> float | None:
+        """Share of the baseline's unexplained output that the improved model explains."""
+        if self.explained is None or self.improved is None or self.explained >= 1.0:
+            return None
+        return (self.improved - self.explained) / (1.0 - self.explained)
+
+    def to_dict(self, limit: float) -> dict:
+        return {"explained_share": self.explained, "nrmse": self.nrmse, "unseen_data": self.unseen,
+                "improved_explained_share": self.improved,
+                "library_explains_share": self.library_share(),
+                "residual_rms": self.residual_rms,
+                "noise_floor": None if self.floor is None else self.floor.to_dict(),
+                "residual_over_floor": self.ratio, "above_floor": self.above(limit),
+                "within_floor": self.within(limit)}
 
 
 @dataclass
@@ -61,7 +135,8 @@ class Tie:
 @dataclass
 class Conclusion:
     """The verdict, the effects named (each alone), the ties, whether a detected mismatch is
-    left unexplained, notes, and the improved model's fit (the last accepted)."""
+    left unexplained, notes, the improved model's fit (the last accepted), whether an effect
+    was accepted, the fit judgement and the verdict's one-line headline (``judge``)."""
 
     verdict: str
     missing: list[str]
@@ -69,11 +144,15 @@ class Conclusion:
     unexplained: bool
     notes: list[str]
     improved_fit: ModelFit | None
+    accepted: bool = False
+    fit: FitJudgement | None = None
+    headline: str = ""
 
 
 def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings,
              f_high: float) -> Conclusion:
-    """The conclusion from the rounds (module docstring)."""
+    """What the rounds found (module docstring); the verdict on the detection and evidence
+    alone, until ``judge`` weighs the fit on unseen data and the noise floor."""
     first, last = rounds[0].detection, rounds[-1].detection
     accepted = [rnd.accepted for rnd in rounds if rnd.accepted is not None]
     missing = [a.effect for a in accepted if a.named]
@@ -84,8 +163,31 @@ def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings
         unexplained = True
         notes.append(f"after adding {', '.join(a.effect for a in accepted)} a mismatch remains "
                      f"(p = {last.p_value:.3g})")
+    for rnd in rounds:
+        for r in rnd.confirmed:
+            if r.at_prior_edge:
+                notes.append(f"{r.effect}: the posterior of {', '.join(r.at_prior_edge)} piles "
+                             "against its prior's bound; the candidate is not trusted")
     verdict = decide_verdict(first.p_value, bool(accepted), settings.unexplained_alpha)
-    if first.significant and not accepted and verdict == "adequate":
+    return Conclusion(verdict, missing, ties, bool(unexplained), notes,
+                      accepted[-1].fit if accepted else None, bool(accepted))
+
+
+def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
+          settings: DiagnosisSettings) -> Conclusion:
+    """The verdict with the fit on unseen data and the noise floor weighed in
+    (``decide_verdict``), its notes and headline."""
+    limit = settings.floor_ratio
+    above, within = fit.above(limit), fit.within(limit)
+    verdict = decide_verdict(first.p_value, found.accepted, settings.unexplained_alpha,
+                             explained=fit.explained, min_explained=settings.min_explained_share,
+                             above_floor=above, within_floor=within)
+    notes, unexplained = list(found.notes), found.unexplained
+    if above and not found.accepted:
+        unexplained = True
+        notes.append(f"the residual is {fit.ratio:.3g} x the recording's noise floor "
+                     f"({fit.floor.method}): a mismatch that no library effect explains")
+    if first.significant and verdict == "adequate":
         notes.append(f"weak mismatch (p = {first.p_value:.3g}) that no library effect explains "
                      f"by evidence; below the bar for an unexplained verdict "
                      f"(p < {settings.unexplained_alpha:g})")
@@ -93,13 +195,54 @@ def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings
         notes.append("prior-posterior conflict on " + ", ".join(
             c.parameter for c in first.conflicts if c.conflict) + " that no library effect "
             "resolves: check the initial modelling and priors")
-    for rnd in rounds:
-        for r in rnd.confirmed:
-            if r.at_prior_edge:
-                notes.append(f"{r.effect}: the posterior of {', '.join(r.at_prior_edge)} piles "
-                             "against its prior's bound; the candidate is not trusted")
-    return Conclusion(verdict, missing, ties, bool(unexplained), notes,
-                      accepted[-1].fit if accepted else None)
+    if fit.explained is not None and fit.explained < settings.min_explained_share and within:
+        notes.append(f"{baseline} explains only {fit.explained:.0%} of the unseen output, but its "
+                     "residual lies at the recording's noise floor: the noise limits what any "
+                     "model can explain")
+    if fit.floor is None:
+        notes.append("no noise floor of the recording's own could be measured (no repeated "
+                     "periods, quiet lead-in or white band): the verdict rests on the "
+                     "detection's replicates and on the share of unseen data explained")
+    return replace(found, verdict=verdict, unexplained=bool(unexplained), notes=notes, fit=fit,
+                   headline=headline(verdict, found, fit, baseline, limit))
+
+
+def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
+             limit: float) -> str:
+    """One line: the verdict, the share of the unseen output the baseline explains, and the
+    noise floor it was judged against."""
+    parts = [verdict]
+    if fit.explained is not None:
+        parts.append(f"{baseline} explains {max(fit.explained, 0.0):.0%} of the {fit.unseen} "
+                     f"output (NRMSE {fit.nrmse:.3g})")
+    else:
+        parts.append(f"{baseline}: no unseen data to judge its fit on")
+    if fit.floor is not None:
+        parts.append(f"residual {fit.ratio:.3g} x the noise floor {fit.floor.rms:.3g} "
+                     f"({fit.floor.method.replace('_', ' ')}, {fit.floor.bound} bound; "
+                     f"mismatch above {limit:g} x)")
+    else:
+        parts.append("no independent noise floor measured")
+    if found.missing or found.ties:
+        named = found.missing + [" / ".join(t.effects) for t in found.ties]
+        parts.append("missing: " + ", ".join(named))
+    share = fit.library_share()
+    if verdict != "adequate":
+        parts.append(_library_phrase(share, found.accepted))
+    return "; ".join(parts)
+
+
+def _library_phrase(share: float | None, accepted: bool) -> str:
+    """Whether the library explains the mismatch, part of it or none."""
+    if not accepted:
+        return "the library explains none of the mismatch"
+    if share is None:
+        return "the library explains part of the mismatch (no unseen data to say how much)"
+    if share >= 0.8:
+        return f"the library explains most of the mismatch ({share:.0%} of the unexplained output)"
+    if share >= 0.2:
+        return f"the library explains part of the mismatch ({share:.0%} of the unexplained output)"
+    return f"the library explains little of the mismatch ({max(share, 0.0):.0%})"
 
 
 def tie_of(best: CandidateResult, rnd: Round, f_high: float) -> Tie:

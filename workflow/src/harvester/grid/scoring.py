@@ -11,8 +11,9 @@ names :data:`ACCEPTED` declares equivalent. Each scenario has one ``outcome``:
 the diagnosis reported, effects it could not tell apart, holds a correct name), ``wrong`` (the
 first effect named alone is not correct, or every tie lacks a correct name: the diagnosis said
 something false), ``missed`` (adequate, or a mismatch without a name or tie). Also reported:
-``top2`` (a correct name among the first two) and ``flagged`` (verdict "missing_physics").
-On an effect-free scenario, a false alarm is the verdict "missing_physics".
+``top2`` (a correct name among the first two) and ``flagged`` (verdict "missing_physics" or
+"inadequate").
+On an effect-free scenario, a false alarm is a flagged verdict.
 
 Rates carry Wilson score intervals (95 %). The goals of the issue: named correctly in at least
 90 % of seeds at a contribution of half the noise RMS, and at most 5 % false alarms.
@@ -58,6 +59,8 @@ log = logging.getLogger("harvester.grid.scoring")
 ACCEPTED: dict[str, tuple[str, ...]] = {"coulomb_friction": ("tanh_friction",)}
 #: Label of the confusion matrix's column for scenarios the diagnosis passed.
 ADEQUATE = "adequate"
+#: Verdicts that say the baseline misses something (``diagnosis.verdict.decide_verdict``).
+FLAGGED = ("missing_physics", "inadequate")
 #: Label for "missing physics" without a named effect.
 UNNAMED = "unnamed"
 #: Goals of the issue.
@@ -77,7 +80,7 @@ def run_diagnosis(recording: pd.DataFrame, baseline: str, known: Mapping[str, fl
                   candidates: Sequence[str] | None = None) -> dict[str, Any]:
     """The diagnosis of one recording as a plain dict, like the CLI's diagnosis.json.
 
-    Keys: ``verdict`` ("adequate" | "missing_physics"), ``missing`` (effect names, most
+    Keys: ``verdict`` ("adequate" | "missing_physics" | "inadequate"), ``missing`` (effect names, most
     probable first), ``candidates`` (per effect: p_value, z, statistic, strength, ...),
     ``locations``, ``fit`` (the baseline's parameters), ``p_value``, ``runtime_s``,
     ``implementation``.
@@ -142,7 +145,7 @@ def accepted_names(effect: str, accepted: Mapping[str, Iterable[str]] | None = N
 def outcome(diagnosis: Mapping[str, Any], correct: set[str]) -> str:
     """named | tied | wrong | missed of one diagnosis of a scenario with an effect (module
     docstring)."""
-    if diagnosis["verdict"] != "missing_physics":
+    if diagnosis["verdict"] not in FLAGGED:
         return "missed"
     missing = list(diagnosis.get("missing") or [])
     if missing:
@@ -179,7 +182,7 @@ def score(truth: Mapping[str, Any], diagnosis: Mapping[str, Any],
     """One row of the results: the scenario's truth beside what the diagnosis said."""
     effect = truth["effect"]
     missing = list(diagnosis.get("missing") or [])
-    flagged = diagnosis["verdict"] == "missing_physics"
+    flagged = diagnosis["verdict"] in FLAGGED
     named = (missing[0] if missing else _tie_label(diagnosis)) if flagged else ADEQUATE
     ok = accepted_names(effect, accepted, truth)
     effect_free = float(truth["ratio"]) == 0.0
