@@ -102,6 +102,10 @@ rule fig07_linear_training:
     params:
         title="Linear model against the training data (Figure 7)",
         window=None,
+        rig=config["rig"],
+        record="training",
+        lead_in=config["preprocess"]["training_lead_in"],
+        zoom_s=1.0,
     log:
         "logs/fig07.log",
     conda:
@@ -119,6 +123,10 @@ rule fig09_tanh_unseen_section:
     params:
         title="Hyperbolic tangent model against a section of the unseen data (Figure 9)",
         window=config["predictive"]["short_window_s"],
+        rig=config["rig"],
+        record="validation",
+        lead_in=config["preprocess"]["validation_lead_in"],
+        zoom_s=None,
     log:
         "logs/fig09.log",
     conda:
@@ -136,6 +144,10 @@ rule fig10_tanh_unseen_full:
     params:
         title="Hyperbolic tangent model against 80 s of unseen data (Figure 10)",
         window=None,
+        rig=config["rig"],
+        record="validation",
+        lead_in=config["preprocess"]["validation_lead_in"],
+        zoom_s=None,
     log:
         "logs/fig10.log",
     conda:

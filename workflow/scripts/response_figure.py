@@ -1,11 +1,34 @@
-"""Rules fig07/fig09/fig10: model mean against measured response with 3-sigma bounds."""
+"""Rules fig07/fig09/fig10: model mean against measured response with 3-sigma bounds (the
+ensemble of parameter samples and the full predictive, each with its share outside), where
+the virtual rig stuck shaded from its truth (the record regenerated from the config), and
+for Figure 7 a section around the rig's longest stick."""
 
-from harvester.plots.predictive import response_figure
+import numpy as np
+
 from harvester.inference.predictive import load_band
+from harvester.plots.predictive import response_figure
 from harvester.runlog import rule_log
+from harvester.synthetic import rig
 
-with rule_log(snakemake):  # noqa: F821
+with rule_log(snakemake) as log:  # noqa: F821
     sm = snakemake  # noqa: F821
     band, measured, _, _ = load_band(sm.input[0])
     window = tuple(sm.params.window) if sm.params.window else None
-    response_figure(band, measured, sm.output[0], sm.params.title, window=window)
+    sim = rig.simulate_record(sm.params.rig, sm.params.record)
+    start = int(sm.params.lead_in)
+    stuck = sim.truth["stuck"][start:start + band.time.size]
+    if stuck.size != band.time.size or not np.allclose(sim.time[start], band.time[0]):
+        raise ValueError(f"{sm.params.record}: the rig's record does not line up with the band")
+    zoom = None
+    if sm.params.zoom_s:
+        edge = np.diff(np.r_[0, stuck.astype(int), 0])
+        runs = list(zip(np.flatnonzero(edge == 1), np.flatnonzero(edge == -1)))
+        if runs:
+            a, b = max(runs, key=lambda r: r[1] - r[0])
+            mid = 0.5 * (band.time[a] + band.time[b - 1])
+            half = 0.5 * float(sm.params.zoom_s)
+            lo = min(max(mid - half, band.time[0]), band.time[-1] - 2 * half)
+            zoom = (lo, lo + 2 * half)
+    log.info("rig stuck at %.2f %% of the shown samples; zoom %s", 100 * stuck.mean(), zoom)
+    response_figure(band, measured, sm.output[0], sm.params.title, window=window, stuck=stuck,
+                    zoom=zoom)

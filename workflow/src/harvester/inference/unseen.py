@@ -5,8 +5,9 @@ parameters, the recording kinds and the output filter in its attributes
 (``identify.identify``); the new recording must have the same kinds. Every posterior sample
 (or a random ``samples`` of them) is simulated from rest for the new input; the output's
 predictive mean and +-3 sd bounds (parameters and noise sigma), the share of the measured
-output outside +-1, 2, 3 sd, the NRMSE and the mean log predictive density are computed after
-the lead-in (and before the filter's end effects).
+output outside +-1, 2, 3 sd of those and of the parameter samples' ensemble alone (the paper's
+bounds, ``outside_ksd_parameter``), the NRMSE and the mean log predictive density are computed
+after the lead-in (and before the filter's end effects).
 """
 
 from __future__ import annotations
@@ -101,6 +102,8 @@ def predict_unseen(problem: Problem, idata: az.InferenceData, samples: int = 200
                "unit": UNITS[problem.output_kind], "nrmse": nrmse(y, mean),
                "mlpd": mlpd(y, part, "predictive"),
                **{f"outside_{k}sd": outside_fraction(y, mean, sd, k) for k in (1, 2, 3)},
+               **{f"outside_{k}sd_parameter": outside_fraction(y, mean, part.sd_parameter, k)
+                  for k in (1, 2, 3)},
                **{f"nominal_outside_{k}sd": NOMINAL_OUTSIDE[k] for k in (1, 2, 3)}}
     return Prediction(band, problem.output, (start, stop), metrics)
 
