@@ -50,12 +50,14 @@ class TailP:
     """A p-value and how it was found: method "rank" (share of replicates at least as large)
     or "tail" (generalised Pareto fit of the largest ``exceedances`` over ``threshold``, shape
     ``xi``, scale ``scale``, goodness-of-fit p ``gof_p``); ``floor``: 1 / (B + 1), the
-    smallest rank p-value of B replicates; ``note``: why the rank stands where it does."""
+    smallest rank p-value of B replicates; ``rank``: the rank p-value (what p was before the
+    tail was modelled); ``note``: why the rank stands where it does."""
 
     p: float
     method: str
     replicates: int
     floor: float
+    rank: float = float("nan")
     exceedances: int = 0
     threshold: float = float("nan")
     xi: float = float("nan")
@@ -142,12 +144,12 @@ def tail_p(observed: float, replicates: np.ndarray, seed: int = 0) -> TailP:
     rank = rank_p(observed, reps)
     count = int(np.sum(reps >= observed)) if observed != -np.inf else b
     if count >= MIN_RANK_COUNT:
-        return TailP(rank, "rank", b, floor)
+        return TailP(rank, "rank", b, floor, rank)
     finite = np.sort(reps[np.isfinite(reps)])[::-1]
     top = min(MAX_EXCEEDANCES, int(MAX_EXCEEDANCE_SHARE * finite.size))
     if top < MIN_EXCEEDANCES:
-        return TailP(rank, "rank", b, floor, note=f"{finite.size} finite replicates: too few "
-                     f"for a tail fit; the p-value cannot fall below {floor:.2g}")
+        return TailP(rank, "rank", b, floor, rank, note=f"{finite.size} finite replicates: too "
+                     f"few for a tail fit; the p-value cannot fall below {floor:.2g}")
     for n_exc in range(top, MIN_EXCEEDANCES - 1, -EXC_STEP):
         threshold = 0.5 * (finite[n_exc - 1] + finite[n_exc])
         y = finite[:n_exc] - threshold
@@ -158,6 +160,7 @@ def tail_p(observed: float, replicates: np.ndarray, seed: int = 0) -> TailP:
         if fit_p >= GOF_ALPHA:
             xi_p, scale_p = (xi, scale) if xi >= 0.0 else (0.0, float(np.mean(y)))
             p = n_exc / b * float(gpd_sf(observed - threshold, xi_p, scale_p))
-            return TailP(p, "tail", b, floor, n_exc, float(threshold), xi, scale, fit_p)
-    return TailP(rank, "rank", b, floor, note="no generalised Pareto fit of the replicates' tail "
-                 f"passed the Anderson-Darling test; the p-value cannot fall below {floor:.2g}")
+            return TailP(p, "tail", b, floor, rank, n_exc, float(threshold), xi, scale, fit_p)
+    return TailP(rank, "rank", b, floor, rank, note="no generalised Pareto fit of the "
+                 "replicates' tail passed the Anderson-Darling test; the p-value cannot fall "
+                 f"below {floor:.2g}")

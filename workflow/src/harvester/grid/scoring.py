@@ -80,8 +80,8 @@ def run_diagnosis(recording: pd.DataFrame, baseline: str, known: Mapping[str, fl
                   candidates: Sequence[str] | None = None) -> dict[str, Any]:
     """The diagnosis of one recording as a plain dict, like the CLI's diagnosis.json.
 
-    Keys: ``verdict`` ("adequate" | "missing_physics" | "inadequate"), ``missing`` (effect names, most
-    probable first), ``candidates`` (per effect: p_value, z, statistic, strength, ...),
+    Keys: ``verdict`` ("adequate" | "missing_physics" | "inadequate"), ``missing`` (effect
+    names, most probable first), ``candidates`` (per effect: p_value, z, statistic, strength, ...),
     ``locations``, ``fit`` (the baseline's parameters), ``p_value``, ``runtime_s``,
     ``implementation``.
 
