@@ -103,7 +103,9 @@ def test_cli_end_to_end_writes_diagnosis_json(recording, tmp_path, capsys):
     assert code == 0
     assert "->" in capsys.readouterr().out
     d = json.loads((out / "diagnosis.json").read_text())
-    assert d["verdict"] in ("adequate", "missing_physics")
+    assert d["verdict"] in ("adequate", "missing_physics", "inadequate")
+    assert d["headline"].startswith(d["verdict"]) and "explains" in d["headline"]
+    assert d["explained_share"] <= 1.0 and d["unseen_nrmse"] > 0
     assert isinstance(d["missing"], list) and all(isinstance(m, str) for m in d["missing"])
     # a linear model of a friction device is not adequate, and friction is what it misses
     assert d["verdict"] == "missing_physics"
@@ -425,6 +427,6 @@ def test_diagnose_a_model_expression_with_warnings_in_its_notes(tmp_path, capsys
     assert code == 0
     assert err.count("sit at the extreme value(s)") == 1  # the warning, once on the console
     d = json.loads((out / "diagnosis.json").read_text())
-    assert d["verdict"] in ("adequate", "missing_physics")
+    assert d["verdict"] in ("adequate", "missing_physics", "inadequate")
     assert any("sit at the extreme value(s)" in n for n in d["notes"])
     assert any(n.startswith("ASSUMED (not measured): M = 12.8 kg") for n in d["notes"])

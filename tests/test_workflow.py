@@ -163,7 +163,8 @@ def test_the_test_configuration_runs_end_to_end_with_its_report(tmp_path):
     validation = pd.read_csv(group / "validation.csv").set_index("model")
     assert validation.loc["tanh", "nrmse"] < validation.loc["linear", "nrmse"]
     diagnosis = json.loads((group / "diagnosis/linear/diagnosis.json").read_text())
-    assert diagnosis["verdict"] in ("missing_physics", "adequate")
+    assert diagnosis["verdict"] in ("missing_physics", "adequate", "inadequate")
+    assert diagnosis["headline"].startswith(diagnosis["verdict"])
     report = work / "report.html"
     proc = snakemake(work, "--report", str(report))
     assert proc.returncode == 0, (proc.stdout + proc.stderr)[-4000:]
