@@ -4,7 +4,8 @@
 from pathlib import Path
 
 from harvester.data.fileio import atomic_path, read_json
-from harvester.groups import diagnose_model, diagnosis_html
+from harvester.diagnosis.summary_page import summary_page
+from harvester.groups import diagnose_model
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821
@@ -13,7 +14,7 @@ with rule_log(snakemake) as log:  # noqa: F821
                           sm.input.priors, sm.wildcards.model, sm.params.settings,
                           Path(sm.output.json).parent)
     with atomic_path(sm.output.summary) as tmp:
-        tmp.write_text(diagnosis_html(read_json(sm.output.json),
-                                      f"Diagnosis of {sm.wildcards.model}, group "
-                                      f"{sm.wildcards.group}"))
+        tmp.write_text(summary_page(read_json(sm.output.json), Path(sm.output.json).parent,
+                                    f"Diagnosis of {sm.wildcards.model}, group "
+                                    f"{sm.wildcards.group}"))
     log.info("verdict %s, missing %s", diag.verdict, diag.missing)

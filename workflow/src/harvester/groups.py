@@ -311,22 +311,3 @@ def diagnose_model(data: str | Path, validation: str | Path | None, posterior: s
     return diagnose_study(checked.data, model, known, priors, unseen, diag_settings, out_dir,
                           posterior=az.from_netcdf(posterior), lead_in=lead_in,
                           samples=samples)
-
-
-def diagnosis_html(doc: Mapping[str, Any], title: str) -> str:
-    """The diagnosis in words for the report: verdict, missing effects, the candidates
-    sampled with their evidence gain, and the fit before and after on unseen data."""
-    lines = [f"verdict: {doc.get('headline') or doc.get('verdict')}",
-             "missing: " + (", ".join(doc.get("missing") or []) or "nothing")]
-    fit = doc.get("fit") or {}
-    for which in ("baseline", "improved"):
-        f = fit.get(which) or {}
-        if f.get("nrmse") is not None:
-            lines.append(f"{which} {f.get('structure')}: NRMSE {f['nrmse']:.4g} on "
-                         f"{f.get('unseen_data')} ({f.get('unseen_seconds', 0):.3g} s)")
-    cols = ["round", "effect", "delta_log_evidence", "delta_log_evidence_se", "threshold",
-            "accepted"]
-    cands = pd.DataFrame([{c: c_.get(c) for c in cols} for c_ in doc.get("candidates") or []],
-                         columns=cols)
-    lines += [f"note: {n}" for n in doc.get("notes") or []]
-    return table_html(cands, title, lines)

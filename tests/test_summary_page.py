@@ -1,0 +1,56 @@
+"""The diagnosis's summary page: one self-contained page, the verdict's headline first."""
+
+from __future__ import annotations
+
+import re
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from harvester.diagnosis.summary_page import summary_page  # noqa: E402
+
+DOC = {
+    "verdict": "missing_physics",
+    "headline": "missing_physics; linear explains 94 % of the validation output (NRMSE 0.233); "
+                "no independent noise floor measured; missing: tanh_friction",
+    "missing": ["tanh_friction"],
+    "ties": [],
+    "candidates": [{"round": 1, "effect": "tanh_friction", "delta_log_evidence": 812.0,
+                    "delta_log_evidence_se": 0.4, "threshold": 5.4, "accepted": True,
+                    "implies": "friction F_c tanh(beta z'): F_c 11.8 +- 0.1 N"}],
+    "fit": {"baseline": {"structure": "linear", "nrmse": 0.233, "unseen_data": "validation"},
+            "improved": {"structure": "tanh", "nrmse": 0.065, "unseen_data": "validation"}},
+    "notes": ["a note <with> markup"],
+    "figures": ["candidates.png", "extra_view.png"],
+}
+
+
+def _png(path):
+    fig, ax = plt.subplots(figsize=(2, 1))
+    ax.plot([0, 1], [0, 1])
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def test_the_page_opens_alone_with_the_headline_first(tmp_path):
+    for name in ("candidates.png", "before_after.png", "extra_view.png"):
+        _png(tmp_path / name)
+    page = summary_page(DOC, tmp_path, "Diagnosis of linear")
+    body = page[page.index("<body>"):]
+    # the headline is the first thing after the title
+    assert re.search(r"<h1>Diagnosis of linear</h1><p class=\"headline\">missing_physics; "
+                     r"linear explains 94 %", body)
+    # every figure embedded, none referenced as a file
+    assert body.count("data:image/png;base64,") == 3
+    assert not re.search(r"src=\"(?!data:)", body)
+    assert "tanh_friction</b>: friction F_c tanh" in body
+    assert "0.233" in body and "94.6%" in body  # the fit before and after, with its share
+    assert "a note &lt;with&gt; markup" in body  # text is escaped
+
+
+def test_sections_without_figures_are_left_out(tmp_path):
+    page = summary_page({**DOC, "figures": []}, tmp_path, "t")
+    assert "data:image" not in page and "The missing force" not in page
+    assert "<h2>The candidates</h2><table>" in page  # the table stands without its figure

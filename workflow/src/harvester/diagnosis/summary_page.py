@@ -1,0 +1,137 @@
+"""The diagnosis as one self-contained page a user reads (``summary.html``).
+
+From diagnosis.json and the figures beside it: the verdict in one sentence (the headline:
+verdict, share of the unseen output explained, noise floor), what is missing with its size,
+the missing force's views where they were made, where the mismatch lies, the candidates, and
+the fit before and after on unseen data; each figure embedded (base64 PNG) with a line saying
+how to read it, so the page opens alone, in a browser or in the Snakemake report.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+#: Sections of the page: (title, [(figure file, how to read it)]), in order. Figures a
+#: diagnosis did not write are left out; figures not listed here go to the last section.
+SECTIONS: tuple[tuple[str, tuple[tuple[str, str], ...]], ...] = (
+    ("The missing force", (
+        ("latent_force.png", "The force the baseline would need to reproduce the recording "
+         "(N), with its 95 % band; a band that holds zero throughout means nothing is "
+         "missing."),
+        ("latent_views.png", "That force against the states: a shape against velocity is "
+         "friction or damping, against displacement a spring or a contact, a loop in (z, f) "
+         "hysteresis."),
+    )),
+    ("Where the mismatch lies", (
+        ("residual_windows.png", "Share of the residual's energy per time window against "
+         "noise replicates: windows far above the band hold the mismatch."),
+        ("state_regions.png", "Share per region of the motion (reversals, large |z|, high "
+         "speed, standstill): the physics that is missing acts where the bars stand out."),
+        ("frequency_bands.png", "Residual energy per band and the part the library's "
+         "signatures explain together."),
+    )),
+    ("The candidates", (
+        ("candidates.png", "Evidence gained by each candidate over the baseline (nats) with "
+         "its Monte Carlo error, against the acceptance threshold."),
+    )),
+    ("The fit before and after, on unseen data", (
+        ("before_after.png", "Measured output (grey), the baseline's and the improved model's "
+         "predictive means (black) on data neither was fitted to."),
+        ("added_parameters.png", "Posteriors of the added effect's parameters against their "
+         "priors: a posterior piled at a prior's bound is a finding, not a result."),
+    )),
+)
+
+
+def _esc(x: Any) -> str:
+    return html.escape(str(x))
+
+
+def _figure(path: Path, how: str) -> str:
+    data = base64.b64encode(path.read_bytes()).decode("ascii")
+    return (f'<figure><img alt="{_esc(path.stem)}" src="data:image/png;base64,{data}">'
+            f"<figcaption>{_esc(how)}</figcaption></figure>")
+
+
+def _missing_lines(doc: Mapping[str, Any]) -> list[str]:
+    """What is missing: each named effect with what it implies, each tie with its members."""
+    cands = {c.get("effect"): c for c in doc.get("candidates") or []}
+    lines = [f"<b>{_esc(e)}</b>: {_esc((cands.get(e) or {}).get('implies', ''))}"
+             for e in doc.get("missing") or []]
+    for tie in doc.get("ties") or []:
+        lines.append("cannot tell apart " + " / ".join(_esc(e) for e in tie.get("effects", []))
+                     + (f"; the experiment that would: {_esc(tie['recommended'])}"
+                        if tie.get("recommended") else ""))
+    return lines or ["no library effect named"]
+
+
+def _fit_rows(doc: Mapping[str, Any]) -> str:
+    fit = doc.get("fit") or {}
+    rows = []
+    for which in ("baseline", "improved"):
+        f = fit.get(which) or {}
+        nrmse = f.get("nrmse")
+        rows.append(f"<tr><td>{which}</td><td>{_esc(f.get('structure'))}</td>"
+                    f"<td>{'-' if nrmse is None else f'{nrmse:.3g}'}</td>"
+                    f"<td>{'-' if nrmse is None else f'{1 - nrmse ** 2:.1%}'}</td>"
+                    f"<td>{_esc(f.get('unseen_data') or '-')}</td></tr>")
+    return ("<table><tr><th></th><th>model</th><th>NRMSE</th><th>share explained</th>"
+            "<th>unseen data</th></tr>" + "".join(rows) + "</table>")
+
+
+def _candidate_rows(doc: Mapping[str, Any]) -> str:
+    rows = [f"<tr><td>{c.get('round')}</td><td>{_esc(c.get('effect'))}</td>"
+            f"<td>{_num(c.get('delta_log_evidence'))} &plusmn; "
+            f"{_num(c.get('delta_log_evidence_se'))}</td><td>{_num(c.get('threshold'))}</td>"
+            f"<td>{'yes' if c.get('accepted') else 'no'}</td></tr>"
+            for c in doc.get("candidates") or []]
+    return ("<table><tr><th>round</th><th>effect</th><th>evidence gain (nats)</th>"
+            "<th>threshold</th><th>accepted</th></tr>" + "".join(rows) + "</table>")
+
+
+def _num(x: Any) -> str:
+    return "-" if x is None else f"{x:.3g}"
+
+
+STYLE = ("body{font-family:sans-serif;max-width:60em;margin:2em auto;color:#222}"
+         ".headline{font-size:1.25em;padding:.6em;border-left:.4em solid #555;background:#f4f4f4}"
+         "figure{margin:1em 0}img{max-width:100%}figcaption{color:#555;font-size:.9em}"
+         "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:.2em .6em}")
+
+
+def summary_page(doc: Mapping[str, Any], figure_dir: str | Path, title: str) -> str:
+    """The page (module docstring) of diagnosis.json ``doc`` with the figures in
+    ``figure_dir``."""
+    figure_dir = Path(figure_dir)
+    body = [f"<h1>{_esc(title)}</h1>",
+            f'<p class="headline">{_esc(doc.get("headline") or doc.get("verdict"))}</p>',
+            "<h2>What is missing</h2><ul>"
+            + "".join(f"<li>{line}</li>" for line in _missing_lines(doc)) + "</ul>"]
+    listed = {name for _, figs in SECTIONS for name, _ in figs}
+    for section, figs in SECTIONS:
+        parts = [_figure(figure_dir / name, how) for name, how in figs
+                 if (figure_dir / name).is_file()]
+        if section == "The candidates":
+            parts.insert(0, _candidate_rows(doc))
+        if section.startswith("The fit"):
+            parts.insert(0, _fit_rows(doc))
+        if parts:
+            body.append(f"<h2>{_esc(section)}</h2>" + "".join(parts))
+    others = [_figure(figure_dir / Path(f).name, "")
+              for f in doc.get("figures") or []
+              if Path(f).name not in listed and (figure_dir / Path(f).name).is_file()]
+    if others:
+        body.append("<h2>Other figures</h2>" + "".join(others))
+    body.append(_notes(doc.get("notes") or []))
+    return (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{_esc(title)}</title>"
+            f"<style>{STYLE}</style></head><body>{''.join(body)}</body></html>\n")
+
+
+def _notes(notes: Sequence[str]) -> str:
+    if not notes:
+        return ""
+    return "<h2>Notes</h2><ul>" + "".join(f"<li>{_esc(n)}</li>" for n in notes) + "</ul>"
