@@ -1,0 +1,311 @@
+"""The missing force: the force f(t) (N) that would make the baseline reproduce the recording,
+estimated as a latent force with its uncertainty (Alvarez, Luengo and Lawrence 2009;
+Hartikainen and Sarkka 2010; Marino and Cicirello 2023).
+
+The baseline (eq. 1 with its terms T, at its posterior mean) and the missing force f:
+
+    M z'' + c_m z' + k z + sum_T X_T(z, z', ...) + f = drive,     drive = -m y'' or F,
+
+X_T the terms' forces on the stated masses (``term_forces``). The smoother estimates the total
+force beyond the linear part, g = sum_T X_T + f, as a Matern Gaussian process (3/2 or 5/2)
+in state-space form, augmented to (z, z'): a linear Gaussian model, so the Kalman filter and
+the Rauch-Tung-Striebel smoother are exact, with no linearisation of sign-like laws that an
+extended filter would turn into a gain of F_c / 1 mm/s. This is the restoring-force surface's
+logic (Masri and Caughey 1979: the force beyond the known linear part, from the measured
+motion) and the GPLFM's (a known linear model plus a latent force), with the baseline's terms
+taken out afterwards: f = g - sum_T X_T along joint draws of the smoothed state path (forward
+filtering, backward sampling), which carries the states' uncertainty into f.
+
+Band. The recording holds the motion only inside the measurement chain's band (the
+likelihood's low-pass, ``ChainProblem.band_hz``), so the force is estimated inside it: the
+drive and the recorded output go through that low-pass, and the force (each draw) too. The
+output is measured every ``stride`` samples, fs / (2 band) (8 at 256 Hz for a 20 Hz
+recording), where the band-limited noise is close to independent.
+
+Hyperparameters. The process's length scale and sd, and the noise sd, maximise the Kalman
+filter's marginal likelihood; the noise sd is bounded above by the baseline's sigma, which
+holds the mismatch as well as the noise (``noise='baseline'`` fixes it there instead).
+The baseline's parameters are held at their posterior mean (their uncertainty is not
+carried).
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import optimize
+
+from harvester.data.signals import lowpass
+from harvester.diagnosis.baseline import BaselineState
+from harvester.diagnosis.state_space import (MATERN_STATES, backward_sample, discretise,
+                                             kalman_filter, matern, rts_smoother)
+from harvester.diagnosis.term_forces import term_forces
+
+log = logging.getLogger("harvester.diagnosis")
+
+#: Length scales (s) the marginal likelihood's search starts from.
+LENGTH_STARTS_S = (0.02, 0.08, 0.3, 1.0)
+#: Draws of the state path that carry the uncertainty into f.
+PATH_DRAWS = 100
+
+
+@dataclass
+class LatentForce:
+    """The missing force over a window: posterior mean and sd (N) at every sample, the
+    smoothed states, the baseline's term forces along them, and how it was estimated."""
+
+    time: np.ndarray  # s
+    force: np.ndarray  # N, posterior mean of f (in the band)
+    sd: np.ndarray  # N
+    rel_disp: np.ndarray  # m, smoothed z
+    disp_sd: np.ndarray  # m, its posterior sd (an acceleration record leaves z's slow part open)
+    rel_vel: np.ndarray  # m/s, smoothed z'
+    rel_acc: np.ndarray  # m/s^2, smoothed z''
+    input: np.ndarray  # the input (m/s^2 or N) in the band
+    baseline_terms: np.ndarray  # N, sum_T X_T along the smoothed states (in the band)
+    baseline: str
+    values: dict  # the baseline's layout parameters (SI)
+    input_kind: str
+    output_kind: str
+    kernel: str
+    length_scale_s: float
+    amplitude_N: float
+    noise_sd: float  # unit of the output
+    baseline_noise_sd: float
+    log_marginal: float  # nats
+    band_hz: float
+    stride: int
+    seconds: float
+    filter_order: int = 8  # the band's zero-phase Butterworth low-pass
+    draws: np.ndarray = field(repr=False, default_factory=lambda: np.empty((0, 0)))
+    #: joint draws of (z, z', z'') along the window, (3, draws, samples), SI units
+    state_draws: np.ndarray = field(repr=False, default_factory=lambda: np.empty((3, 0, 0)))
+
+    @property
+    def lower(self) -> np.ndarray:
+        return self.force - 2.0 * self.sd
+
+    @property
+    def upper(self) -> np.ndarray:
+        return self.force + 2.0 * self.sd
+
+    @property
+    def rms_N(self) -> float:
+        return float(np.sqrt(np.mean(self.force**2)))
+
+    def band(self, x: np.ndarray) -> np.ndarray:
+        """``x`` (samples along the last axis) through the band's low-pass, as the force."""
+        if not np.isfinite(self.band_hz):
+            return np.asarray(x, dtype=float)
+        fs = 1.0 / float(self.time[1] - self.time[0])
+        return lowpass(x, fs, self.band_hz, self.filter_order)
+
+    def to_dict(self) -> dict:
+        """diagnosis.json's entry: size, settings and hyperparameters (no time history)."""
+        return {"baseline": self.baseline, "rms_N": self.rms_N,
+                "peak_N": float(np.max(np.abs(self.force))),
+                "mean_sd_N": float(np.mean(self.sd)),
+                "share_beyond_2sd": float(np.mean(np.abs(self.force) > 2.0 * self.sd)),
+                "disp_sd_m": float(np.sqrt(np.mean(self.disp_sd**2))),
+                "window_s": [float(self.time[0]), float(self.time[-1])],
+                "input_kind": self.input_kind, "output_kind": self.output_kind,
+                "kernel": self.kernel, "length_scale_s": self.length_scale_s,
+                "amplitude_N": self.amplitude_N, "noise_sd": self.noise_sd,
+                "baseline_noise_sd": self.baseline_noise_sd, "log_marginal": self.log_marginal,
+                "band_hz": self.band_hz, "stride": self.stride, "seconds": self.seconds}
+
+
+@dataclass
+class _Device:
+    """The baseline's linear part, its drive and measurement over the record."""
+
+    values: dict
+    dt: float
+    drive: np.ndarray  # N
+    base: np.ndarray  # y'' in the band (zeros for a force input)
+    input: np.ndarray
+    y: np.ndarray
+    measured: np.ndarray
+    kind: str
+    z_scale: float
+    v_scale: float
+
+    @property
+    def M(self) -> float:
+        return float(self.values["M"])
+
+    def H(self) -> tuple[np.ndarray, float]:
+        """Measurement row on (z, z', g) and the drive's feedthrough."""
+        M, c, k = self.M, self.values["c_m"], self.values["k"]
+        if self.kind == "rel_disp":
+            return np.array([1.0, 0.0, 0.0]), 0.0
+        return np.array([-k / M, -c / M, -1.0 / M]), 1.0 / M
+
+
+def _device(state: BaselineState, stop: int, stride: int) -> tuple[_Device, np.ndarray]:
+    """The baseline's linear part, drive and measurement, and its residual in the output's
+    kind (both through the chain) over the record's first ``stop`` samples."""
+    p = state.problem
+    theta = np.asarray(state.theta, dtype=float)
+    values = dict(p.known)
+    values.update(zip(p.structure.free_parameters, theta[:-1]))
+    u = p.chain(np.asarray(p.input, dtype=float))[:stop]
+    force_input = p.input_kind == "force"
+    drive = u if force_input else -values["m"] * u
+    y = p.measured_chain[:stop]
+    measured = np.zeros(stop, dtype=bool)
+    measured[::stride] = True
+    sim = p.simulate(theta)
+    if not sim.ok[0]:
+        raise RuntimeError(f"the baseline {p.structure.name} cannot be simulated at theta")
+    out = sim.rel_disp[0] if p.output_kind == "rel_disp" else sim.rel_acc[0]
+    scale = lambda x: float(max(np.sqrt(np.mean(np.square(x[:stop]))), 1e-9))  # noqa: E731
+    dev = _Device(values, p.dt, drive, np.zeros(stop) if force_input else u, u, y, measured,
+                  p.output_kind, scale(sim.rel_disp[0]), scale(sim.rel_vel[0]))
+    return dev, y - p.chain(out)[:stop]
+
+
+def _model(dev: _Device, kernel: str, length: float, amp: float, noise: float):
+    """The augmented model in scaled states (z / z_s, z' / v_s, g^(j) / (amp lam^j)):
+    (discrete model, H, D, R, initial mean and covariance, scales)."""
+    F, q, P_inf = matern(kernel, length, amp)
+    p = len(F)
+    n = 2 + p
+    M, c, k = dev.M, dev.values["c_m"], dev.values["k"]
+    A = np.zeros((n, n))
+    A[0, 1], A[1, 0], A[1, 1], A[1, 2] = 1.0, -k / M, -c / M, -1.0 / M
+    A[2:, 2:] = F
+    b = np.zeros(n)
+    b[1] = 1.0 / M
+    W = np.zeros((n, n))
+    W[-1, -1] = q
+    lam = np.sqrt(2.0 * (p - 0.5)) / length
+    T = np.concatenate([[dev.z_scale, dev.v_scale], amp * lam ** np.arange(p)])
+    Ti = 1.0 / T
+    disc = discretise(Ti[:, None] * A * T[None, :], Ti * b, Ti[:, None] * W * Ti[None, :],
+                      dev.dt)
+    h3, D = dev.H()
+    H = np.zeros(n)
+    H[:3] = h3 * T[:3]
+    P0 = np.zeros((n, n))
+    P0[:2, :2] = np.diag([1e-4, 1e-4])
+    P0[2:, 2:] = P_inf * np.outer(Ti[2:], Ti[2:])
+    return disc, H, D, noise**2, np.zeros(n), P0, T
+
+
+def _filter(dev: _Device, kernel: str, length: float, amp: float, noise: float):
+    disc, H, D, R, m0, P0, T = _model(dev, kernel, length, amp, noise)
+    out = kalman_filter(disc.Phi, disc.G0, disc.G1, disc.Q, H, D, R, dev.drive, dev.y,
+                        dev.measured, m0, P0)
+    return out, disc, T
+
+
+def fit_hyperparameters(dev: _Device, kernel: str, amp0: float, noise_max: float,
+                        fit_noise: bool) -> tuple[float, float, float, float]:
+    """(length scale s, amplitude N, noise sd, log marginal likelihood) maximising the
+    Kalman filter's marginal likelihood; the noise sd at most ``noise_max`` (fixed there
+    unless ``fit_noise``)."""
+    duration = dev.dt * len(dev.y)
+    lo = np.log([4.0 * dev.dt, 1e-3 * amp0, 1e-3 * noise_max])
+    hi = np.log([duration / 4.0, 1e3 * amp0, noise_max])
+
+    def cost(x):
+        length, amp, noise = np.exp(x) if fit_noise else (*np.exp(x), noise_max)
+        try:
+            value = -_filter(dev, kernel, length, amp, noise)[0][4]
+        except (np.linalg.LinAlgError, ValueError):
+            return 1e300
+        return value if np.isfinite(value) else 1e300
+
+    dims = 3 if fit_noise else 2
+    starts = [np.array([np.log(ls), np.log(amp0), np.log(0.5 * noise_max)])[:dims]
+              for ls in LENGTH_STARTS_S if np.log(ls) > lo[0]]
+    x0 = min(starts, key=cost)
+    res = optimize.minimize(cost, x0, method="L-BFGS-B",
+                            bounds=list(zip(lo[:dims], hi[:dims])), options={"maxiter": 60})
+    length, amp, noise = np.exp(res.x) if fit_noise else (*np.exp(res.x), noise_max)
+    return float(length), float(amp), float(noise), float(-res.fun)
+
+
+def measurement_stride(state: BaselineState) -> int:
+    """Samples between the outputs the smoother measures: fs / (2 x the chain's band), where
+    the band-limited noise is close to independent (1 without a band below Nyquist)."""
+    p = state.problem
+    band = getattr(p, "band_hz", None)
+    return 1 if band is None else max(1, int(np.floor(0.5 / (p.dt * band))))
+
+
+def _force_scale(dev: _Device, residual: np.ndarray) -> float:
+    """The force the baseline's residual implies (N): M x its RMS for an acceleration, k x it
+    for a displacement; the search's starting amplitude."""
+    gain = dev.values["k"] if dev.kind == "rel_disp" else dev.M
+    return max(gain * float(np.std(residual)), 1e-6)
+
+
+def _paths(dev: _Device, disc, T, filtered, draws: int, seed: int):
+    """Smoothed means (samples, states) and joint draws of the state path (draws, samples,
+    states), in SI units."""
+    mf, Pf, mp, Pp, _ = filtered
+    ms, _, J, C = rts_smoother(disc.Phi, mf, Pf, mp, Pp)
+    noise = np.random.default_rng(seed).standard_normal((draws, len(dev.y), len(T)))
+    return ms * T, backward_sample(mf, mp, J, C, noise) * T
+
+
+def _acceleration(dev: _Device, z, v, g):
+    """z'' (m/s^2) of the linear part under the total force g."""
+    return (dev.drive - dev.values["c_m"] * v - dev.values["k"] * z - g) / dev.M
+
+
+def _terms_along(state: BaselineState, dev: _Device, z, v, g) -> np.ndarray:
+    """sum_T X_T (N) of the baseline's terms along paths (draws, samples); 0 without terms."""
+    layout = state.problem.structure.layout
+    if not layout.terms:
+        return np.zeros_like(np.atleast_2d(z))
+    a = _acceleration(dev, z, v, g)
+    forces = term_forces(layout, dev.values, z, v, a, dev.base, dev.dt)
+    return sum(forces.values())
+
+
+def latent_force(state: BaselineState, window: tuple[int, int] | None = None, *,
+                 kernel: str = "matern52", noise: str | float = "fit",
+                 draws: int = PATH_DRAWS, seed: int = 0) -> LatentForce:
+    """The missing force of the baseline ``state`` over ``window`` (samples; the problem's
+    by default), module docstring. ``kernel``: 'matern32' or 'matern52'; ``noise``: 'fit'
+    (marginal likelihood, at most the baseline's sigma), 'baseline' (its sigma) or a value in
+    the output's unit; ``draws``: joint draws of the state path behind the sd."""
+    if kernel not in MATERN_STATES:
+        raise ValueError(f"kernel must be one of {sorted(MATERN_STATES)}, got {kernel!r}")
+    clock = time.perf_counter()
+    p = state.problem
+    start, stop = window or p.window
+    stride = measurement_stride(state)
+    dev, residual = _device(state, stop, stride)
+    sigma_b = float(state.theta[-1])
+    fixed = None if noise == "fit" else (sigma_b if noise == "baseline" else float(noise))
+    length, amp, noise_sd, logml = fit_hyperparameters(
+        dev, kernel, _force_scale(dev, residual[start:stop]), fixed or sigma_b, fixed is None)
+    filtered, disc, T = _filter(dev, kernel, length, amp, noise_sd)
+    mean, paths = _paths(dev, disc, T, filtered, draws, seed)
+    z, v, g = paths[..., 0], paths[..., 1], paths[..., 2]
+    f_paths = p.chain(g - _terms_along(state, dev, z, v, g))
+    terms_mean = p.chain(_terms_along(state, dev, mean[:, 0], mean[:, 1], mean[:, 2])[0])
+    force = p.chain(mean[:, 2]) - terms_mean if not p.structure.layout.terms \
+        else f_paths.mean(axis=0)
+    w = slice(start, stop)
+    acc = _acceleration(dev, mean[:, 0], mean[:, 1], mean[:, 2])
+    out = LatentForce(
+        np.arange(stop)[w] * p.dt, force[w], f_paths.std(axis=0)[w], mean[w, 0],
+        z[:, w].std(axis=0), mean[w, 1],
+        acc[w], dev.input[w], terms_mean[w], p.structure.name, dev.values, p.input_kind,
+        p.output_kind,
+        kernel, length, amp, noise_sd, sigma_b, logml, float(getattr(p, "band_hz", np.nan)),
+        stride, 0.0, int(getattr(p, "filter_order", 8)), f_paths[:, w],
+        np.stack([z[:, w], v[:, w], _acceleration(dev, z, v, g)[:, w]]))
+    out.seconds = time.perf_counter() - clock
+    log.info("latent force of %s: RMS %.3g N (sd %.2g N), length scale %.3g s, noise %.3g "
+             "(baseline's sigma %.3g), %.1f s", p.structure.name, out.rms_N, np.mean(out.sd),
+             length, noise_sd, sigma_b, out.seconds)
+    return out

@@ -1,0 +1,268 @@
+"""What the missing force looks like: a small dictionary of shapes fitted to the latent force
+(``latent.LatentForce``), each with the share of the missing force it explains,
+
+    share = 1 - sum (f - f_shape)^2 / sum f^2      (f the posterior mean over the window),
+
+and the best one said in one sentence ("a force periodic in z, period 3.0 mm, amplitude
+5.0 N, explains 70 % of the missing force"). The shapes, each linear in its amplitudes, with
+at most one scanned parameter:
+
+``odd in z``        k_1 z + k_3 z^3 + k_5 z^5 (a stiffness error, a hardening spring)
+``even in z``       f_0 + k_2 z^2 + k_4 z^4 (an offset, an asymmetric spring)
+``friction``        F tanh(z' / v_0), v_0 scanned (Coulomb to a smooth sign law)
+``damping``         c z' + c_2 z'|z'| (a viscous error, quadratic damping)
+``periodic in z``   a cos(2 pi z / P) + b sin(2 pi z / P), the period P scanned (cogging,
+                    a ball screw's or a gear's pitch, a magnetic detent)
+``drift``           f_0 + s t (a slow change: temperature, a sensor's offset creeping)
+``line``            a cos(2 pi f_0 t) + b sin(2 pi f_0 t), f_0 from the force's periodogram
+                    (mains hum, a motor's or a pump's frequency, a structural mode driven
+                    from outside)
+``loop``            F h(t), h the library's Dahl state (``hysteresis``) at unit force, its
+                    pre-sliding displacement delta scanned (a hysteresis loop in (z, f))
+``inertial``        dM z'' + dm y'' (a mass error, the diagnosis's catch-all name; it is
+                    here so that a named mass error can be checked against the force's shape)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import optimize
+
+from harvester.diagnosis.latent import LatentForce
+from harvester.diagnosis.term_forces import term_force
+from harvester.model.terms import term
+
+#: Points of each scanned parameter's grid before the refinement.
+SCAN_POINTS = 40
+#: A shape is preferred to one earlier in the dictionary only if it explains this much more.
+SHARE_MARGIN = 0.02
+
+
+@dataclass
+class Shape:
+    """One shape fitted to the missing force: its share, parameters and sentence."""
+
+    name: str
+    share: float
+    parameters: dict[str, float]
+    sentence: str
+    fitted: np.ndarray = field(repr=False)
+
+    def to_dict(self) -> dict:
+        return {"shape": self.name, "share": self.share, "parameters": self.parameters,
+                "sentence": self.sentence}
+
+
+@dataclass
+class ShapeDescription:
+    """Every shape of the dictionary, best first, and the one-sentence description."""
+
+    shapes: list[Shape]
+    rms_N: float
+    mean_sd_N: float
+    sentence: str
+
+    @property
+    def best(self) -> Shape:
+        return self.shapes[0]
+
+    def shape(self, name: str) -> Shape:
+        return next(s for s in self.shapes if s.name == name)
+
+    def to_dict(self) -> dict:
+        return {"sentence": self.sentence, "rms_N": self.rms_N, "mean_sd_N": self.mean_sd_N,
+                "shapes": [s.to_dict() for s in self.shapes]}
+
+
+def _fit(f: np.ndarray, basis: np.ndarray, band: Callable) -> tuple[np.ndarray, np.ndarray,
+                                                                     float]:
+    """(coefficients, fitted, share) of least squares of f on the columns of ``basis``, each
+    column through ``band`` first (the low-pass the latent force is estimated in)."""
+    basis = band(np.asarray(basis, dtype=float).T).T
+    coef, *_ = np.linalg.lstsq(basis, f, rcond=None)
+    fitted = basis @ coef
+    return coef, fitted, 1.0 - float(np.sum((f - fitted) ** 2) / max(np.sum(f**2), 1e-300))
+
+
+def _unfiltered(x: np.ndarray) -> np.ndarray:
+    return x
+
+
+def _scan(f: np.ndarray, make: Callable[[float], np.ndarray], grid: np.ndarray,
+          band: Callable) -> tuple[float, np.ndarray, np.ndarray, float]:
+    """(best scanned value, coefficients, fitted, share): the best of ``grid`` (positive; the
+    bases unfiltered, which moves no peak and costs a tenth), refined by a bounded search
+    between its neighbours."""
+    shares = [_fit(f, make(x), _unfiltered)[2] for x in grid]
+    i = int(np.argmax(shares))
+    ends = np.log([grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]])
+    lo, hi = ends.min(), ends.max()
+    if hi > lo:
+        res = optimize.minimize_scalar(lambda u: -_fit(f, make(np.exp(u)), band)[2],
+                                       bounds=(lo, hi), method="bounded",
+                                       options={"xatol": 1e-4})
+        x = float(np.exp(res.x)) if -res.fun > _fit(f, make(grid[i]), band)[2] \
+            else float(grid[i])
+    else:
+        x = float(grid[i])
+    coef, fitted, share = _fit(f, make(x), band)
+    return x, coef, fitted, share
+
+
+def _rms(x: np.ndarray) -> float:
+    return float(max(np.sqrt(np.mean(x**2)), 1e-12))
+
+
+def _explains(share: float) -> str:
+    return f"explains {100.0 * max(share, 0.0):.0f} % of the missing force"
+
+
+def odd_in_z(lf: LatentForce, f: np.ndarray) -> Shape:
+    """k_1 z + k_3 z^3 + k_5 z^5 for the share; k_1 (N/m) and k_3 (N/m^3) from k_1 z + k_3 z^3
+    alone (with z^5 beside it k_3 trades against k_5)."""
+    s = _rms(lf.rel_disp)
+    x = lf.rel_disp / s
+    _, fitted, share = _fit(f, np.column_stack([x, x**3, x**5]), lf.band)
+    coef = _fit(f, np.column_stack([x, x**3]), lf.band)[0]
+    k = coef / s ** np.array([1, 3])
+    sentence = (f"a force odd in z (k_1 = {k[0]:.3g} N/m, k_3 = {k[1]:.3g} N/m^3), "
+                f"{_explains(share)}")
+    return Shape("odd in z", share, {"k1_N_per_m": k[0], "k3_N_per_m3": k[1]}, sentence,
+                 fitted)
+
+
+def even_in_z(lf: LatentForce, f: np.ndarray) -> Shape:
+    """f_0 + k_2 z^2 + k_4 z^4 (N, N/m^2, N/m^4)."""
+    s = _rms(lf.rel_disp)
+    x = lf.rel_disp / s
+    coef, fitted, share = _fit(f, np.column_stack([np.ones_like(x), x**2, x**4]), lf.band)
+    k = coef / s ** np.array([0, 2, 4])
+    sentence = (f"a force even in z (offset {k[0]:.3g} N, k_2 = {k[1]:.3g} N/m^2), "
+                f"{_explains(share)}")
+    return Shape("even in z", share, {"offset_N": k[0], "k2_N_per_m2": k[1],
+                                      "k4_N_per_m4": k[2]}, sentence, fitted)
+
+
+def friction(lf: LatentForce, f: np.ndarray) -> Shape:
+    """F tanh(z' / v_0) (N), v_0 (m/s) scanned from 1e-3 to 1 x the RMS velocity."""
+    sv = _rms(lf.rel_vel)
+    grid = np.geomspace(1e-3 * sv, sv, SCAN_POINTS)
+    v0, coef, fitted, share = _scan(f, lambda v: np.tanh(lf.rel_vel / v)[:, None], grid, lf.band)
+    sentence = (f"a friction-like force F sgn(z') of {coef[0]:.3g} N (smoothed over "
+                f"{1e3 * v0:.2g} mm/s), {_explains(share)}")
+    return Shape("friction", share, {"F_N": coef[0], "v0_m_per_s": v0}, sentence, fitted)
+
+
+def damping(lf: LatentForce, f: np.ndarray) -> Shape:
+    """c z' + c_2 z'|z'| (N s/m, N s^2/m^2)."""
+    v = lf.rel_vel
+    coef, fitted, share = _fit(f, np.column_stack([v, v * np.abs(v)]), lf.band)
+    sentence = (f"a damping force (c = {coef[0]:.3g} N s/m, c_2 = {coef[1]:.3g} "
+                f"N s^2/m^2), {_explains(share)}")
+    return Shape("damping", share, {"c_N_s_per_m": coef[0], "c2_N_s2_per_m2": coef[1]},
+                 sentence, fitted)
+
+
+def _pair(phase: np.ndarray) -> np.ndarray:
+    return np.column_stack([np.cos(phase), np.sin(phase)])
+
+
+def periodic_in_z(lf: LatentForce, f: np.ndarray) -> Shape:
+    """a cos(2 pi z / P) + b sin(2 pi z / P), P (m) scanned from the range of z to 1/200 of
+    it in steps of a quarter of a period over the range (the peak's width)."""
+    z = lf.rel_disp
+    span = float(np.ptp(z)) or 1e-9
+    grid = span / np.arange(1.0, 200.0, 0.25)
+    P, coef, fitted, share = _scan(f, lambda p: _pair(2.0 * np.pi * z / p), grid, lf.band)
+    amp = float(np.hypot(*coef))
+    sentence = (f"a force periodic in z, period {1e3 * P:.3g} mm, amplitude {amp:.3g} N, "
+                f"{_explains(share)}")
+    return Shape("periodic in z", share, {"period_m": P, "amplitude_N": amp}, sentence,
+                 fitted)
+
+
+def drift(lf: LatentForce, f: np.ndarray) -> Shape:
+    """f_0 + s t: a slow change (N, N/s) over the window."""
+    t = lf.time - lf.time.mean()
+    coef, fitted, share = _fit(f, np.column_stack([np.ones_like(t), t]), lf.band)
+    sentence = (f"a force drifting slowly in time, {coef[1]:.3g} N/s (from {fitted[0]:.3g} N "
+                f"to {fitted[-1]:.3g} N), {_explains(share)}")
+    return Shape("drift", share, {"slope_N_per_s": coef[1], "mean_N": coef[0]}, sentence,
+                 fitted)
+
+
+def line(lf: LatentForce, f: np.ndarray) -> Shape:
+    """a cos(2 pi f_0 t) + b sin(2 pi f_0 t), f_0 (Hz) at the periodogram's peak (zero-padded
+    8x) refined by least squares."""
+    t = lf.time
+    dt = float(np.median(np.diff(t)))
+    n = 8 * len(t)
+    power = np.abs(np.fft.rfft(f - f.mean(), n)) ** 2
+    freqs = np.fft.rfftfreq(n, dt)
+    j = int(np.argmax(power[1:])) + 1
+    grid = freqs[max(j - 1, 1): j + 2]
+    f0, coef, fitted, share = _scan(f, lambda x: _pair(2.0 * np.pi * x * t), grid, lf.band)
+    amp = float(np.hypot(*coef))
+    sentence = (f"a line at {f0:.4g} Hz, amplitude {amp:.3g} N, {_explains(share)}")
+    return Shape("line", share, {"frequency_hz": f0, "amplitude_N": amp}, sentence, fitted)
+
+
+def loop(lf: LatentForce, f: np.ndarray) -> Shape:
+    """F h(t): the library's Dahl state at unit force (``hysteresis``) along z', its
+    pre-sliding displacement delta (m) scanned from 1e-3 to 1 x the RMS displacement."""
+    t_h = term("hysteresis")
+    sz = _rms(lf.rel_disp)
+    zero = np.zeros_like(lf.time)
+
+    def basis(delta: float) -> np.ndarray:
+        values = {"F_hyst": 1.0, "delta_hyst": delta, "c_hyst": 0.0}
+        return term_force(t_h, values, zero, lf.rel_vel, zero, zero, float(lf.time[1] -
+                                                                           lf.time[0]))[0][:, None]
+
+    grid = np.geomspace(1e-3 * sz, sz, SCAN_POINTS // 2)
+    delta, coef, fitted, share = _scan(f, basis, grid, lf.band)
+    sentence = (f"a hysteresis loop in (z, f), {coef[0]:.3g} N wide at saturation, "
+                f"pre-sliding over {1e3 * delta:.2g} mm, {_explains(share)}")
+    return Shape("loop", share, {"F_N": coef[0], "delta_m": delta}, sentence, fitted)
+
+
+def inertial(lf: LatentForce, f: np.ndarray) -> Shape:
+    """dM z'' + dm y'' (kg): a mass error (dm only for a base-acceleration input)."""
+    cols = [lf.rel_acc] + ([lf.input] if lf.input_kind == "base_acc" else [])
+    coef, fitted, share = _fit(f, np.column_stack(cols), lf.band)
+    dm = float(coef[1]) if len(coef) > 1 else 0.0
+    sentence = (f"an inertial force (dM = {coef[0]:.3g} kg on z'', dm = {dm:.3g} kg on "
+                f"y''), {_explains(share)}")
+    return Shape("inertial", share, {"dM_kg": float(coef[0]), "dm_kg": dm}, sentence, fitted)
+
+
+#: The dictionary, in the order a tie goes (simpler and more common physics first). The
+#: inertial shape is not in it: every force above the device's resonance moves z'' by about
+#: -f / M, so a regression on z'' explains any fast force as a large negative mass error (a
+#: Coulomb force of 6 N came out as dM = -10 kg on M = 12.8 kg, 94 %); it serves to check a
+#: named mass error (``describe(lf, DICTIONARY + (inertial,))``).
+DICTIONARY = (odd_in_z, even_in_z, friction, damping, periodic_in_z, drift, line, loop)
+
+
+def describe(lf: LatentForce, dictionary=DICTIONARY) -> ShapeDescription:
+    """Every shape of ``dictionary`` fitted to the missing force, best first (a shape later in
+    the dictionary goes first only if it explains SHARE_MARGIN more), and the sentence."""
+    f = lf.force
+    fitted = [shape(lf, f) for shape in dictionary]
+    ranked = sorted(fitted, key=lambda s: -s.share)
+    best = ranked[0]
+    for s in fitted:  # the earliest shape within the margin of the best
+        if s.share >= best.share - SHARE_MARGIN:
+            best = s
+            break
+    ranked = [best] + [s for s in ranked if s is not best]
+    rms, sd = lf.rms_N, float(np.mean(lf.sd))
+    if rms < 2.0 * sd:
+        sentence = (f"no missing force beyond its uncertainty (RMS {rms:.3g} N against an sd "
+                    f"of {sd:.3g} N)")
+    else:
+        sentence = f"{best.sentence} (RMS {rms:.3g} N)"
+    return ShapeDescription(ranked, rms, sd, sentence)

@@ -1,0 +1,151 @@
+"""The forces of a model's terms along given state paths, each as the force it adds to the
+left-hand side of eq. (1) with the stated masses M and m:
+
+    M z'' + c_m z' + k z + sum_T X_T = drive,     drive = -m y'' (base input) or F (force).
+
+``screw``    X = force(z', h...; params), internal states h advanced along the path
+             (``displacement_update`` where the term has one, else its ``state_rates``)
+``mass``     X = force(z; params)
+``inertia``  (M, m) -> (M', m') = masses(M, m; params): X = (M' - M) z'' + (m' - m) y''
+``mode``     states (u, u') driven by the path's z'' and y'' (RK4 with the acceleration
+             linear in a step); X = -force(u, u'; params) + (M' - M) z'' + (m' - m) y''
+``coupling`` not expressible as a force on the mass (a dead zone between two inertias)
+
+Each term's law is the library's own (``harvester.model.codegen.compiled``): no physics is
+written twice. Paths are arrays (draws, samples); all in SI units (N).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numba as nb
+import numpy as np
+
+from harvester.model.codegen import compiled
+from harvester.model.structures import Layout
+from harvester.model.terms import Term
+
+#: Fewest sub-steps per sample for a mode's states, and its largest omega_n h.
+MODE_SUBSTEPS, MODE_RATE_H = 4, 0.3
+
+
+@nb.njit(cache=True)
+def _stateless(force, x, params):
+    out = np.empty_like(x)
+    for i in range(x.shape[0]):
+        for k in range(x.shape[1]):
+            out[i, k] = force(x[i, k], *params)
+    return out
+
+
+@nb.njit(cache=True)
+def _with_update(force, update, v, dt, params):
+    """A screw term with one rate-independent state: h advanced by the exact update along
+    each step's displacement (trapezoidal velocity), from h = 0."""
+    out = np.empty_like(v)
+    for i in range(v.shape[0]):
+        h = 0.0
+        for k in range(v.shape[1]):
+            if k > 0:
+                h = update(h, 0.5 * (v[i, k - 1] + v[i, k]) * dt, *params)
+            out[i, k] = force(v[i, k], h, *params)
+    return out
+
+
+@nb.njit(cache=True)
+def _with_rates(force, rates, v, dt, n_sub, params):
+    """A screw term with one state: h' = rates(w, h) by RK2 with ``n_sub`` steps per
+    sample, w linear in the sample, from h = 0."""
+    out = np.empty_like(v)
+    hs = dt / n_sub
+    for i in range(v.shape[0]):
+        h = 0.0
+        for k in range(v.shape[1]):
+            if k > 0:
+                for s in range(n_sub):
+                    w0 = v[i, k - 1] + (v[i, k] - v[i, k - 1]) * s / n_sub
+                    w1 = v[i, k - 1] + (v[i, k] - v[i, k - 1]) * (s + 1) / n_sub
+                    k1 = rates(w0, h, *params)
+                    k2 = rates(w1, h + hs * k1, *params)
+                    h = h + 0.5 * hs * (k1 + k2)
+            out[i, k] = force(v[i, k], h, *params)
+    return out
+
+
+@nb.njit(cache=True)
+def _mode(force, rates, a, yb, dt, n_sub, params):
+    """A mode's force on the mass along paths of z'' (a) and y'' (yb), RK4 from rest."""
+    out = np.empty_like(a)
+    hs = dt / n_sub
+    for i in range(a.shape[0]):
+        u, ud = 0.0, 0.0
+        for k in range(a.shape[1]):
+            if k > 0:
+                a0, da = a[i, k - 1], (a[i, k] - a[i, k - 1]) / n_sub
+                y0, dy = yb[k - 1], (yb[k] - yb[k - 1]) / n_sub
+                for s in range(n_sub):
+                    p1 = rates(u, ud, a0 + da * s, y0 + dy * s, *params)
+                    am, ym = a0 + da * (s + 0.5), y0 + dy * (s + 0.5)
+                    p2 = rates(u + 0.5 * hs * p1[0], ud + 0.5 * hs * p1[1], am, ym, *params)
+                    p3 = rates(u + 0.5 * hs * p2[0], ud + 0.5 * hs * p2[1], am, ym, *params)
+                    p4 = rates(u + hs * p3[0], ud + hs * p3[1], a0 + da * (s + 1),
+                               y0 + dy * (s + 1), *params)
+                    u += hs / 6.0 * (p1[0] + 2.0 * p2[0] + 2.0 * p3[0] + p4[0])
+                    ud += hs / 6.0 * (p1[1] + 2.0 * p2[1] + 2.0 * p3[1] + p4[1])
+            out[i, k] = force(u, ud, *params)
+    return out
+
+
+def _inertial(t: Term, values: Mapping[str, float], params: tuple, a: np.ndarray,
+              yb: np.ndarray) -> np.ndarray:
+    """(M' - M) z'' + (m' - m) y'' of a term that changes the masses."""
+    M, m = values["M"], values["m"]
+    M2, m2 = t.masses(M, m, *params)
+    return (M2 - M) * a + (m2 - m) * yb[None, :]
+
+
+def term_force(t: Term, values: Mapping[str, float], z: np.ndarray, v: np.ndarray,
+               a: np.ndarray, yb: np.ndarray, dt: float) -> np.ndarray:
+    """X_T (N) of one term (module docstring) along paths (draws, samples) of z (m), z'
+    (m/s) and z'' (m/s^2), with y'' (m/s^2, samples; zeros for a force input)."""
+    params = tuple(float(values[p]) for p in t.parameter_names)
+    z, v, a = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (z, v, a))
+    yb = np.asarray(yb, dtype=float)
+    if t.kind == "mass":
+        return _stateless(compiled(t.name, "force"), z, params)
+    if t.kind == "screw" and t.n_states == 0:
+        return _stateless(compiled(t.name, "force"), v, params)
+    if t.kind == "screw" and t.displacement_update is not None:
+        return _with_update(compiled(t.name, "force"), compiled(t.name, "displacement_update"),
+                            v, dt, params)
+    if t.kind == "screw" and t.n_states == 1:
+        return _with_rates(compiled(t.name, "force"), compiled(t.name, "state_rates"), v, dt,
+                           16, params)
+    if t.kind == "inertia":
+        return _inertial(t, values, params, a, yb)
+    if t.kind == "mode":
+        rate = 2.0 * np.pi * abs(values.get("f_mode", 0.0)) * dt
+        n_sub = max(MODE_SUBSTEPS, int(np.ceil(rate / MODE_RATE_H)))
+        f = _mode(compiled(t.name, "force"), compiled(t.name, "state_rates"), a, yb, dt, n_sub,
+                  params)
+        return -f + _inertial(t, values, params, a, yb)
+    raise NotImplementedError(f"term {t.name} ({t.kind}) has no force on the mass alone")
+
+
+def term_forces(layout: Layout, values: Mapping[str, float], z: np.ndarray, v: np.ndarray,
+                a: np.ndarray, yb: np.ndarray, dt: float) -> dict[str, np.ndarray]:
+    """X_T (N) of every term of ``layout`` (by name) along paths (:func:`term_force`);
+    ``values`` holds every layout parameter."""
+    return {t.name: term_force(t, values, z, v, a, yb, dt) for t in layout.terms}
+
+
+def model_force(layout: Layout, values: Mapping[str, float], z: np.ndarray, v: np.ndarray,
+                a: np.ndarray, yb: np.ndarray, dt: float) -> np.ndarray:
+    """c_m z' + k z + sum_T X_T (N) along paths: everything of eq. (1) but M z'' and the
+    drive."""
+    z, v = np.atleast_2d(z), np.atleast_2d(v)
+    total = values["c_m"] * v + values["k"] * z
+    for f in term_forces(layout, values, z, v, a, yb, dt).values():
+        total = total + f
+    return total
