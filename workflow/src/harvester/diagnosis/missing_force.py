@@ -1,0 +1,76 @@
+"""The missing force in one call, for the diagnosis run and its diagnosis.json: the latent force
+of the baseline (``latent``), its shape (``shapes``), its views (``latent_views``), each named
+effect's force beside it with its size and relevance (``relevance``), and the figures
+(``latent_figures``)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from harvester.diagnosis.baseline import BaselineState
+from harvester.diagnosis.latent import LatentForce, latent_force
+from harvester.diagnosis.latent_views import Binned, EffectForce, effect_force, views
+from harvester.diagnosis.relevance import (EffectSize, RelevanceFloor, effect_size,
+                                           response_change)
+from harvester.diagnosis.shapes import ShapeDescription, describe
+from harvester.model.structures import ModelStructure
+
+
+@dataclass(frozen=True)
+class NamedEffect:
+    """A term the diagnosis named and the improved model that holds it: its structure and
+    parameters (free parameters, sigma last optional)."""
+
+    term: str
+    structure: ModelStructure
+    theta: np.ndarray
+
+
+@dataclass
+class MissingForce:
+    """The missing force, its shape and views, and the named effects beside it."""
+
+    latent: LatentForce
+    description: ShapeDescription
+    views: dict[str, Binned]
+    effects: list[EffectForce] = field(default_factory=list)
+    sizes: list[EffectSize] = field(default_factory=list)
+    figure_files: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        """diagnosis.json's ``missing_force`` entry."""
+        return {"latent_force": self.latent.to_dict(),
+                "shape": self.description.to_dict(),
+                "views": {k: v.to_dict() for k, v in self.views.items()},
+                "named_effects": [{**ef.to_dict(), **size.to_dict()}
+                                  for ef, size in zip(self.effects, self.sizes)],
+                "figures": self.figure_files}
+
+
+def missing_force(state: BaselineState, window: tuple[int, int] | None = None,
+                  named: Sequence[NamedEffect] = (), unseen_input: np.ndarray | None = None,
+                  unseen_window: slice | None = None, floor: RelevanceFloor = RelevanceFloor(),
+                  out_dir: str | Path | None = None, **latent_kwargs) -> MissingForce:
+    """Everything of the missing force for a baseline ``state`` (module docstring);
+    ``unseen_input`` (the held-out or validation input, ``unseen_window`` of it) gives each
+    named effect's change of the predicted response; figures in ``out_dir`` if given."""
+    lf = latent_force(state, window, **latent_kwargs)
+    desc = describe(lf)
+    out = MissingForce(lf, desc, views(lf))
+    for effect in named:
+        ef = effect_force(lf, effect.structure, effect.theta, state.problem.known, effect.term)
+        response = None
+        if unseen_input is not None:
+            response = response_change(state.problem, state.theta, effect.structure,
+                                       effect.theta, unseen_input,
+                                       unseen_window or slice(None))
+        out.effects.append(ef)
+        out.sizes.append(effect_size(lf, ef, floor, response))
+    if out_dir is not None:
+        from harvester.diagnosis.latent_figures import all_latent_figures
+        out.figure_files = all_latent_figures(lf, desc, out_dir, out.effects)
+    return out
