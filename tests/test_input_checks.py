@@ -11,6 +11,7 @@ sampling; ``test_cli`` runs the commands end to end).
 
 from __future__ import annotations
 
+import functools
 import logging
 import time
 
@@ -75,6 +76,38 @@ def _txt(f, sidecar=SIDECAR):
     return lambda df, tmp: (f(_text(df, tmp)), sidecar)
 
 
+def _force(f):
+    """The valid recording driven by the force that moves its mass as its base did,
+    F = -m y'' (eq. 1), in N; M, k in the sidecar."""
+    def make(df, tmp):
+        d = df.assign(force=-8.0 * df.base_acc)[["time", "force", "rel_acc"]]
+        return _text(f(d), tmp), "M: 12.8\nk: 250.0\n"
+    return make
+
+
+@functools.lru_cache(maxsize=1)
+def displacement_recording() -> pd.DataFrame:
+    """8 s at 256 Hz of the tanh device under a base displacement of three sines (1 cm each at
+    0.7, 1.3, 2.1 Hz) as a laser would record it: base_disp, and rel_disp with 10 um noise."""
+    from harvester.model.simulate import simulate
+    from harvester.model.structures import Layout
+    fs, n = 256.0, 2048
+    t = np.arange(n) / fs
+    freqs, phases = np.array([0.7, 1.3, 2.1]), np.array([0.3, 1.1, 2.0])
+    w = 2 * np.pi * freqs[:, None]
+    y = 0.01 * np.sum(np.sin(w * t + phases[:, None]), axis=0)
+    acc = -0.01 * np.sum(w**2 * np.sin(w * t + phases[:, None]), axis=0)
+    lay = Layout.of(("tanh_friction",))
+    values = {**TABLE1_KNOWN, **TANH_TABLE5}
+    sim = simulate(lay, np.array([values[p] for p in lay.parameter_names]), acc, 1 / fs)
+    z = sim.rel_disp[0] + 1e-5 * np.random.default_rng(3).standard_normal(n)
+    return pd.DataFrame({"time": t, "base_disp": y, "rel_disp": z})
+
+
+def _disp(f, sidecar=SIDECAR):
+    return lambda df, tmp: (_text(f(displacement_recording().copy()), tmp), sidecar)
+
+
 def _semicolons(text: str, decimal_comma: bool) -> str:
     rows = [line.split(",") for line in text.splitlines()]
     if decimal_comma:
@@ -107,7 +140,7 @@ CASES = [
      ["line 17", "column 'base_acc'", "empty value"]),
     ("missing_column", _df(lambda d: d.drop(columns="rel_acc")), "diagnose", ERROR,
      ["line 1", "column 'rel_acc'", "missing column: harvester diagnose needs an output column",
-      "rel_acc (m/s^2)", "accelerations only", "the header reads 'time,base_acc'"]),
+      "rel_acc (m/s^2) or rel_disp (m)", "the header reads 'time,base_acc'"]),
     ("header_only", _txt(lambda t: t.splitlines()[0] + "\n"), "diagnose", ERROR,
      ["0 samples (no data rows after the header); at least 64"]),
     ("too_short", _df(lambda d: d.iloc[:1280]), "diagnose", ERROR,
@@ -147,10 +180,20 @@ CASES = [
      ["line 300", "column 'base_acc'", "1e+300 m/s^2", "beyond any sensor's range"]),
     ("time_in_ms", _df(lambda d: d.assign(time=d.time * 1000.0)), "diagnose", ERROR,
      ["line 3", "column 'time'", "0.256 Hz", "time column in ms", "256 Hz"]),
-    ("force_input", _df(lambda d: d.rename(columns={"base_acc": "force"})), "diagnose", ERROR,
-     ["column 'force'", "needs the input base_acc (m/s^2)", "this file has force"]),
-    ("displacement_output", _df(lambda d: d.rename(columns={"rel_acc": "rel_disp"})),
-     "diagnose", ERROR, ["needs the output rel_acc", "this file has rel_disp"]),
+    # the other kinds (issue 41): a force, displacements, a base displacement
+    ("force_in_kN", _force(lambda d: d.assign(force=d.force / 1000.0)), "diagnose", ERROR,
+     ["median |rel_acc / force|", "1/M = 0.07812, from the sidecar", "factor 1000",
+      "force in kN", "unit slipped"]),
+    ("acceleration_as_force", _df(lambda d: d.rename(columns={"base_acc": "force"})),
+     "diagnose", ERROR, ["|rel_acc / force|", "times the most a passive device allows",
+                         "unit slipped"]),
+    ("rel_disp_in_mm", _disp(lambda d: d.assign(rel_disp=d.rel_disp * 1000.0)), "diagnose",
+     ERROR, ["column 'rel_disp'", "m/s RMS", "faster than the 5 m/s", "masses in kg",
+             "probably mm"]),
+    ("base_disp_in_mm", _disp(lambda d: d.assign(base_disp=d.base_disp * 1000.0)),
+     "diagnose", ERROR, ["column 'base_disp'", "more than 5 m", "probably mm"]),
+    ("rel_disp_unit_in_header", _disp(lambda d: d.rename(columns={"rel_disp": "rel_disp_mm"})),
+     "diagnose", ERROR, ["line 1", "column 'rel_disp_mm'", "in mm", "'rel_disp' in m"]),
     ("no_sidecar", _txt(lambda t: t, None), "diagnose", ERROR,
      ["rec.yaml", "needs M, m, k", "no sidecar", "--paper-device"]),
     ("unit_in_header", _txt(lambda t: t.replace("base_acc", "base_acc [g]", 1)), "diagnose",
@@ -172,6 +215,16 @@ CASES = [
      ["column 'temperature'", "constant (21)", "not used"]),
     ("paper_device_assumed", _txt(lambda t: t, None), "check --paper-device", OK,
      ["ASSUMED (not measured)", "M = 12.8 kg", "the paper's Table 1 (--paper-device)"]),
+    ("force_valid", _force(lambda d: d), "check", OK, ["0 warning(s)"]),
+    ("displacements_valid", _disp(lambda d: d), "check", OK, ["0 warning(s)"]),
+    ("fast_displacements_no_masses", _disp(lambda d: d.assign(base_disp=d.base_disp * 100.0,
+                                                               rel_disp=d.rel_disp * 100.0),
+                                            None),
+     "check", OK, ["column 'base_disp'", "m/s RMS", "faster than the 5 m/s", "in mm?",
+                   "a circuit in volts"]),
+    ("drifting_base", _disp(lambda d: d.assign(base_disp=d.base_disp + 0.004 * d.time)),
+     "check", OK, ["column 'base_disp'", "drifts by 0.03", "m over 8 s", "RMS oscillation",
+                   "drifting sensor"]),
 ]
 
 
@@ -213,7 +266,9 @@ def test_the_matrix_covers_the_issue():
                  "duplicate_times", "negative_M", "unknown_sidecar_key", "missing_file",
                  "directory", "gravity_left_in", "gap_0.1s", "utf8_bom", "crlf", "dead_output",
                  "saturated_30pct", "base_acc_in_g", "cell_1e300", "time_in_ms", "semicolons",
-                 "decimal_commas", "displacement_output", "no_sidecar"):
+                 "decimal_commas", "no_sidecar",
+                 # issue 41: the new kinds
+                 "force_in_kN", "rel_disp_in_mm", "base_disp_in_mm", "drifting_base"):
         assert case in ids, case
 
 

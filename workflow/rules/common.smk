@@ -179,28 +179,29 @@ def validation_dir(group, model, recording):
 
 def diagnosable(group):
     """Whether a group's diagnosis runs: config groups.<group>.diagnose (default true) and a
-    training recording the diagnosis takes (base_acc -> rel_acc, M, m and k known)."""
+    training recording the diagnosis takes (every kind: input base_acc, base_disp or force,
+    output rel_acc or rel_disp; M, m and k known, M and k for a force input)."""
     s = GROUPS[group]
     if not s["diagnose"]:
         return False
     if group == STUDY_GROUP:
         return True
     rec = SHEET.groups[group].training
+    need = {"M", "m", "k"}
     if SHEET.row(rec)["kind"] == "converted":
         header = recording_header(SHEET.file(rec))
-        if not {"base_acc", "rel_acc"} <= set(header):
-            logger.warning(f"group {group}: no diagnosis (it needs base_acc -> rel_acc; "
-                           f"{rec} has {header[1:3]}); set groups.{group}.diagnose: false")
-            return False
+        if "force" in header:
+            need = {"M", "k"}  # m does not enter eq. (1) with a force input
     known = set()
     if s["priors"]:
         known = set(yaml.safe_load(Path(s["priors"]).read_text())["known"]) \
             if Path(s["priors"]).exists() else {"M", "m", "k"}
     elif SHEET.sidecar(rec):
         known = set(yaml.safe_load(Path(SHEET.sidecar(rec)).read_text()) or {})
-    if not {"M", "m", "k"} <= known:
-        logger.warning(f"group {group}: no diagnosis (it needs M, m and k in the sidecar of "
-                       f"{rec}); set groups.{group}.diagnose: false to silence this")
+    if not need <= known:
+        logger.warning(f"group {group}: no diagnosis (it needs {', '.join(sorted(need))} in "
+                       f"the sidecar of {rec}); set groups.{group}.diagnose: false to silence "
+                       "this")
         return False
     return True
 

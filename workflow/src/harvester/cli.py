@@ -36,6 +36,8 @@ RECORDING_HELP = """\
 recording: a CSV file, comma-separated, '.' as the decimal point, with a header:
   time      s       uniform steps
   base_acc  m/s^2   input: base acceleration (gravity removed), or
+  base_disp m       input: base displacement (laser, LVDT; differentiated twice into
+                    base_acc by the library, band-limited at filtered_at_hz), or
   force     N       input: force on the mass, base fixed
   rel_acc   m/s^2   output: acceleration of the mass relative to the base, or
   rel_disp  m       output: displacement of the mass relative to the base
@@ -48,11 +50,9 @@ exit status: 0 done, 2 bad input (named: file, line or column, found, expected).
 
 #: Sampler defaults of the command line (the study's config: 1000 particles x 4 chains).
 CLI_TMCMC = {"particles": 500, "chains": 2, "mcmc_steps": 3, "target_accept": 0.25}
-DIAGNOSE_KINDS = ("harvester diagnose", ("its detection, location and priors work on "
-                                         "accelerations only (harvester.diagnosis); identify, "
-                                         "compare and predict take force and rel_disp too"))
 DIAGNOSE_NEEDS = ("harvester diagnose (its priors of c_m and F_c come from the recording's "
-                  "FRF with M, m, k, and its candidates' priors scale with M and k)")
+                  "FRF with M, m, k (M, k for a force input), and its candidates' priors "
+                  "scale with M and k)")
 
 _log_to_file = False
 
@@ -106,8 +106,9 @@ COMMAND_TEXTS: dict[str, tuple[str, str, str]] = {
                  "harvester diagnose rec.csv --baseline tanh --out diag",
                  "writes DIR/diagnosis.json (verdict, missing effects, candidates' log "
                  "evidence in nats, where the mismatch lies, the fit before and after; "
-                 "notes: warnings and assumptions) and figures. Needs base_acc and rel_acc, and "
-                 "M, m, k (sidecar or --paper-device)."),
+                 "notes: warnings and assumptions) and figures. Takes every kind of "
+                 "recording (input base_acc, base_disp or force, output rel_acc or rel_disp) "
+                 "and needs M, m, k (M, k for a force input; sidecar or --paper-device)."),
     "terms": ("list the physics library: terms, equations, units, priors", "harvester terms",
               "prints the base equation and every term"),
     "power": ("power the harvester would make on your base acceleration, per load, with its "
@@ -477,11 +478,14 @@ def _diagnosis_settings(args: argparse.Namespace, lowpass: float | None):
 
 def _diagnosis_inputs(args: argparse.Namespace):
     """(recording, validation, lowpass, known, sidecar priors, warnings and notes)."""
+    from harvester.data.kinds import INPUTS, OUTPUTS, input_kind
     from harvester.data.recording import Accepted
     from harvester.data.signals import filter_recording
-    accept = Accepted(("base_acc",), ("rel_acc",), *DIAGNOSE_KINDS)
+    accept = Accepted(tuple(INPUTS), tuple(OUTPUTS), "harvester diagnose",
+                      "time, one input and one output column")  # every kind
     checked, kp = _read(args.recording, args.paper_device, accept)
-    kp.require(("M", "m", "k"), DIAGNOSE_NEEDS, checked.sidecar)
+    force = input_kind(checked.kinds.input_kind).force_input
+    kp.require(("M", "k") if force else ("M", "m", "k"), DIAGNOSE_NEEDS, checked.sidecar)
     df, lowpass = checked.data, args.filtered_at or checked.sidecar.filtered_at_hz
     notes = [str(w) for w in checked.warnings] + kp.notes(checked.sidecar)
     validation = None
@@ -493,10 +497,11 @@ def _diagnosis_inputs(args: argparse.Namespace):
         if not 0 < args.lowpass < 0.5 / checked.dt:
             raise DataError(args.recording, f"--lowpass {args.lowpass} Hz must lie in (0, "
                             f"{0.5 / checked.dt:g}) Hz")
-        df = filter_recording(df, args.lowpass, args.filter_order, str(args.recording))
+        output = (checked.kinds.output_kind,)  # the output alone, as the option says
+        df = filter_recording(df, args.lowpass, args.filter_order, str(args.recording), output)
         if validation is not None:
             validation = filter_recording(validation, args.lowpass, args.filter_order,
-                                          str(args.validation))
+                                          str(args.validation), output)
         lowpass = args.lowpass
     return df, validation, lowpass, kp.values, checked.sidecar, notes
 
@@ -512,7 +517,8 @@ def diagnose_command(args: argparse.Namespace) -> int:
     check_recording(df, str(args.recording), settings.lead_in_s,
                     0.0 if validation is not None else settings.holdout_fraction)
     try:
-        priors = recording_priors(df, known, sidecar.priors, str(args.recording))
+        priors = recording_priors(df, known, sidecar.priors, str(args.recording),
+                                  settings.lowpass_hz)
     except KeyError as err:  # a prior in the sidecar for a parameter the library lacks
         raise DataError(sidecar.path, str(err.args[0])) from None
     key = _key(args, Path(args.validation) if args.validation else None)
@@ -521,8 +527,7 @@ def diagnose_command(args: argparse.Namespace) -> int:
                         settings=settings, source=str(args.recording))
         diag.notes[:0] = notes
         write(diag, stage)
-    print(f"{diag.verdict}" + (f": {', '.join(diag.missing)}" if diag.missing else "")
-          + f" -> {args.out / 'diagnosis.json'}")
+    print(f"{diag.headline} -> {args.out / 'diagnosis.json'}")
     return 0
 
 

@@ -298,10 +298,13 @@ def diagnose_model(data: str | Path, validation: str | Path | None, posterior: s
     from harvester.data.sidecar import KnownParameters
     from harvester.diagnosis import DiagnosisSettings, diagnose_study
 
+    from harvester.data.kinds import input_kind
+
     known, priors = read_priors(priors_file)
     checked = read_checked_recording(data, known=known, known_from=str(priors_file))
-    KnownParameters(known, known, {}, "").require(("M", "m", "k"), "the diagnosis",
-                                                  checked.sidecar)
+    force = input_kind(checked.kinds.input_kind).force_input  # any kind (data.kinds)
+    KnownParameters(known, known, {}, "").require(("M", "k") if force else ("M", "m", "k"),
+                                                  "the diagnosis", checked.sidecar)
     unseen = None if validation is None else \
         read_checked_recording(validation, known=known, known_from=str(priors_file)).data
     diag_settings = replace(DiagnosisSettings.from_config(settings["diagnosis"]),

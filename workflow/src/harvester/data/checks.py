@@ -55,7 +55,9 @@ from harvester.data.recording import G, RecordingKinds, check_plausible
 
 #: Largest magnitude a column of each kind can hold (SI units): beyond any sensor's range.
 MAX_MAGNITUDE: dict[str, float] = {"base_acc": 1.0e5, "rel_acc": 1.0e5, "force": 1.0e8,
-                                   "rel_disp": 1.0e3, "time": 1.0e9}
+                                   "rel_disp": 1.0e3, "base_disp": 1.0e3, "time": 1.0e9}
+#: Columns that hold a displacement (may rest while friction holds the mass or the base).
+DISPLACEMENTS = ("rel_disp", "base_disp")
 #: Lowest sampling rate (Hz) of a vibration recording the method can use.
 MIN_SAMPLING_HZ = 10.0
 #: A run of equal values this long (s, and at least FLAT_RUN_SAMPLES) in an acceleration or a
@@ -171,7 +173,7 @@ def flat_stretches(df: pd.DataFrame, kinds: RecordingKinds, dt: float, source: s
     out = []
     need = max(FLAT_RUN_SAMPLES, int(round(FLAT_RUN_S / dt)))
     for name in df.columns:
-        if name in ("time", "rel_disp"):
+        if name == "time" or name in DISPLACEMENTS:
             continue
         x = df[name].to_numpy(dtype=float)
         if name not in (kinds.input_kind, kinds.output_kind):
@@ -212,7 +214,7 @@ def saturation(df: pd.DataFrame, kinds: RecordingKinds, dt: float, source: str |
                 f"{', '.join(f'{v:g}' for v in levels)} in runs of up to {longest} samples "
                 f"({longest * dt:.3g} s), first at line {_line(lines, first)}: a clipped "
                 "sensor or an ADC at the end of its range")
-        if name != "rel_disp" and count / x.size > SATURATED_SHARE:
+        if name not in DISPLACEMENTS and count / x.size > SATURATED_SHARE:
             raise DataError(source, f"saturated: {what}; at most {SATURATED_SHARE:.0%} can be "
                             "tolerated: record again with a larger range", column=name)
         out.append(CheckWarning(str(source), "saturation", what, column=name,
@@ -270,16 +272,19 @@ def gain_above_resonance(df: pd.DataFrame, kinds: RecordingKinds, dt: float,
     MIN_SEGMENT_S long; at least MIN_LINES lines) with coherence >= MIN_COHERENCE
     above RESONANCE_MARGIN x the natural frequency sqrt(k/M) / 2 pi (without M and k: the
     upper half of the coherent lines), below 0.4 x the rate and 0.8 x ``lowpass_hz`` (a
-    low-pass of the output alone lowers the gain above it), of |H|, times w^2 for a
-    displacement output (and its 90th percentile over the lines). Bound: eq. (1)
+    low-pass of the output alone lowers the gain above it), of |H| in accelerations (times
+    w^2 for a displacement output, over w^2 for a displacement input; the kinds' ``order``,
+    ``harvester.data.kinds``), and its 90th percentile over the lines. Bound: eq. (1)
     with any damping or friction, |z''/y''| <= (m/M) w^2 / (w^2 - w_n^2) for a base input
     (m/M <= 1 when not known: M = m + J (2 pi / l)^2), |z''/F| <= (1/M) w^2 / (w^2 - w_n^2)
     for a force input (None without M). Returns None when nothing can be judged.
     """
+    from harvester.data.kinds import input_kind, output_kind
+    inp, out = input_kind(kinds.input_kind), output_kind(kinds.output_kind)
     M, m, k = (known.get(p) for p in ("M", "m", "k"))
-    if kinds.input_kind == "force" and M is None:
+    if inp.force_input and M is None:
         return None
-    scale = (m / M if M and m else 1.0) if kinds.input_kind == "base_acc" else 1.0 / M
+    scale = 1.0 / M if inp.force_input else (m / M if M and m else 1.0)
     u, y = (_winsorised(df[c].to_numpy(float)) for c in (kinds.input_kind, kinds.output_kind))
     fs = 1.0 / dt
     nper = int(min(round(2.0 * fs), u.size // 4))
@@ -291,8 +296,10 @@ def gain_above_resonance(df: pd.DataFrame, kinds: RecordingKinds, dt: float,
     _, s_uy = signal.csd(u, y, **kw)
     with np.errstate(divide="ignore", invalid="ignore"):
         coh = np.abs(s_uy) ** 2 / (s_uu * s_yy)
-        gain = np.abs(s_uy) / s_uu * ((2 * np.pi * f) ** 2 if kinds.output_kind == "rel_disp"
-                                      else 1.0)
+        # in accelerations: a displacement output times w^2, a displacement input over w^2
+        w = 2 * np.pi * f
+        gain = np.abs(s_uy) / s_uu * w ** (2 - out.order) / (
+            1.0 if inp.force_input else w ** (2 - inp.order))
     top = min(0.4 * fs, 0.8 * lowpass_hz) if lowpass_hz else 0.4 * fs
     ok = (f > 0) & (f < top) & (coh >= MIN_COHERENCE)
     f_n = np.sqrt(k / M) / (2 * np.pi) if M and k else None
@@ -309,6 +316,10 @@ def gain_above_resonance(df: pd.DataFrame, kinds: RecordingKinds, dt: float,
             "gain": float(np.median(gain[ok])), "ratio": float(np.median(ratio)),
             "ratio_p90": float(np.quantile(ratio, 0.9)), "scale": float(scale),
             "known": bool(f_n)}
+
+
+#: The unit slip each input kind is most often recorded with.
+_SLIP_EXAMPLE = {"base_acc": "base_acc in g", "force": "force in kN", "base_disp": "base_disp in mm"}
 
 
 def check_units_by_physics(df: pd.DataFrame, kinds: RecordingKinds, dt: float,
@@ -330,7 +341,8 @@ def check_units_by_physics(df: pd.DataFrame, kinds: RecordingKinds, dt: float,
         return [CheckWarning(str(source), "unit", f"{kinds.output_kind} hardly follows "
                              f"{kinds.input_kind} (largest coherence {g['coherence']:.2f}): "
                              "friction holding the device, or unrelated or swapped channels")]
-    name = "m/M" if kinds.input_kind == "base_acc" else "1/M"
+    force = kinds.input_kind == "force"
+    name = "1/M" if force else "m/M"
     what = (f"{name} = {g['scale']:.4g}, from {known_from}" if "M" in known else
             f"{name} <= 1: M, m not known") + (", times w^2 / (w^2 - w_n^2)" if g["known"] else "")
     evidence = (f"above resonance ({g['band_hz'][0]:.3g}-{g['band_hz'][1]:.3g} Hz, {g['lines']} "
@@ -341,9 +353,9 @@ def check_units_by_physics(df: pd.DataFrame, kinds: RecordingKinds, dt: float,
         raise DataError(source, f"{evidence}{_factor_named(g['ratio'])}: a unit slipped "
                         f"({kinds.input_kind} must be in {kinds.input_unit}, "
                         f"{kinds.output_kind} in {kinds.output_unit}; e.g. "
-                        f"{'base_acc in g' if kinds.input_kind == 'base_acc' else 'force in kN'}"
+                        f"{_SLIP_EXAMPLE[kinds.input_kind]}"
                         f"), or the M, m in {known_from} are wrong")
-    scale_known = "M" in known and ("m" in known or kinds.input_kind == "force")
+    scale_known = "M" in known and ("m" in known or force)
     if scale_known and g["ratio_p90"] < 1.0 / (2.0 * UNIT_RATIO):
         return [CheckWarning(str(source), "unit", f"{evidence}; even its 90th percentile is "
                              f"{g['ratio_p90']:.3g} times it{_factor_named(g['ratio_p90'])}: "
@@ -367,6 +379,144 @@ def check_clock_against_device(dt: float, known: Mapping[str, float], source: st
                          f"2 pi = {f_n:.3g} Hz (k, M from {known_from}) is above a quarter of "
                          f"the {fs:.4g} Hz sampling rate: the clock does not match the device "
                          "(time in ms instead of s?)", column="time")]
+
+
+#: Share of the output's in-band power coherent with the input below which a recording is
+#: visibly nonlinear (or noisy) for the checks that rest on linear theory.
+MIN_COHERENT_SHARE = 0.5
+#: Weighted RMS log-FRF misfit (nepers) of the best linear eq. (1) above which the response is
+#: not a linear device's. Measured: 0.04-0.06 on a sprung mass with 4 N of Coulomb friction
+#: under 3 m/s^2 (also with a column in g), 0.2-0.43 with 20-40 N; 1.6-1.7 on the frame of
+#: Marino and Cicirello (tests/test_kinds.py).
+MAX_FRF_MISFIT = 0.5
+#: Output level against input level over the record's quarters: a slope of log RMS off 1 by
+#: more than this is an amplitude-dependent response, when the input's level varies by at
+#: least AMPLITUDE_RANGE between quarters.
+AMPLITUDE_SLOPE_TOL = 0.25
+AMPLITUDE_RANGE = 1.5
+
+
+@dataclass(frozen=True)
+class Nonlinearity:
+    """How far a recording departs from a linear, noise-free input-output relation.
+
+    ``coherent_share``: the share of the output's power (0 Hz to 0.4 x the rate) that is
+    coherent with the input, sum gamma^2 S_yy / sum S_yy (Welch, 2 s segments): 1 for a
+    linear device without noise; friction's harmonics and sticking, or noise, lower it.
+    ``slope``: d log RMS(output) / d log RMS(input) over the record's quarters (1 for a
+    linear device), None when the input's level does not vary by AMPLITUDE_RANGE.
+    ``frf_misfit``: the weighted RMS log misfit (nepers) of the best linear eq. (1) to the
+    measured FRF, where one was fitted (``harvester.initial.frf``); a narrow-band excitation
+    of a friction device leaves the first two near their linear values and shows here.
+    """
+
+    coherent_share: float
+    slope: float | None
+    input_range: float
+    frf_misfit: float | None = None
+
+    @property
+    def visible(self) -> bool:
+        return self.coherent_share < MIN_COHERENT_SHARE or (
+            self.slope is not None and abs(self.slope - 1.0) > AMPLITUDE_SLOPE_TOL) or (
+            self.frf_misfit is not None and self.frf_misfit > MAX_FRF_MISFIT)
+
+    def evidence(self) -> str:
+        amp = (f"the output's level grows as the input's to the power {self.slope:.2f} over "
+               f"the record's quarters (1 if linear)" if self.slope is not None else
+               f"the input's level varies by {self.input_range:.2f}x over the record's "
+               "quarters (too little to see an amplitude dependence)")
+        fit = ("" if self.frf_misfit is None else
+               f"; the best linear model misses the measured FRF by {self.frf_misfit:.2f} "
+               f"nepers RMS (a factor {np.exp(self.frf_misfit):.2g}; a linear device: below "
+               f"{MAX_FRF_MISFIT:g})")
+        return (f"{self.coherent_share:.0%} of the output's power is coherent with the input "
+                f"(a linear device without noise: 100 %); {amp}{fit}")
+
+
+def nonlinearity(u: np.ndarray, y: np.ndarray, fs: float,
+                 top_hz: float | None = None) -> Nonlinearity:
+    """:class:`Nonlinearity` of input ``u`` and output ``y`` sampled at ``fs`` Hz (the band
+    ends at ``top_hz``, default 0.4 x the rate)."""
+    u, y = _winsorised(np.asarray(u, float)), _winsorised(np.asarray(y, float))
+    nper = int(max(16, min(round(2.0 * fs), u.size // 4)))
+    kw = {"fs": fs, "nperseg": nper, "noverlap": nper // 2, "detrend": "linear"}
+    f, s_uu = signal.welch(u, **kw)
+    _, s_yy = signal.welch(y, **kw)
+    _, s_uy = signal.csd(u, y, **kw)
+    band = (f > 0) & (f <= (top_hz or 0.4 * fs))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        coh = np.where(s_uu * s_yy > 0, np.abs(s_uy) ** 2 / (s_uu * s_yy), 0.0)
+    total = float(np.sum(s_yy[band]))
+    share = float(np.sum(np.clip(coh[band], 0, 1) * s_yy[band]) / total) if total > 0 else 0.0
+    quarters = np.array_split(np.arange(u.size), 4)
+    ru = np.array([np.std(signal.detrend(u[q])) for q in quarters])
+    ry = np.array([np.std(signal.detrend(y[q])) for q in quarters])
+    ok = (ru > 0) & (ry > 0)
+    spread = float(ru[ok].max() / ru[ok].min()) if ok.sum() >= 2 else 1.0
+    slope = float(np.polyfit(np.log(ru[ok]), np.log(ry[ok]), 1)[0]) \
+        if spread >= AMPLITUDE_RANGE and ok.sum() >= 3 else None
+    return Nonlinearity(share, slope, spread)
+
+
+#: Largest RMS velocity (m/s) of a rig's displacement (its band-limited derivative): beyond
+#: it the column is probably in mm (3 mm at 1 Hz read as m moves at 13 m/s RMS).
+MAX_VELOCITY_RMS = 5.0
+
+
+def fast_displacements(df: pd.DataFrame, kinds: RecordingKinds, dt: float,
+                       source: str | Path, known: Mapping[str, float] | None = None,
+                       known_from: str = "the sidecar") -> list[CheckWarning]:
+    """A displacement column (rel_disp, base_disp) whose derivative
+    (``harvester.data.kinds.derivative``, band-limited at the DAQ's edge) moves faster than
+    MAX_VELOCITY_RMS: mm read as m. DataError for a mechanical device (its mass M or m known
+    in kg, ``known``), which no rig moves that fast; a warning otherwise: a device known only
+    through its recordings may be in other units (a circuit whose 'displacement' is a
+    voltage)."""
+    from harvester.data.kinds import derivative
+    mechanical = bool({"M", "m"} & set(known or {}))
+    out = []
+    for name in (kinds.input_kind, kinds.output_kind):
+        if name not in DISPLACEMENTS or len(df) < 8:
+            continue
+        v = derivative(df[name].to_numpy(dtype=float), dt, 1, None)
+        rms = float(np.std(v))
+        if rms > MAX_VELOCITY_RMS and mechanical:
+            raise DataError(source, f"{name} moves at {rms:.3g} m/s RMS (its derivative), "
+                            f"faster than the {MAX_VELOCITY_RMS:g} m/s a shaker or rig reaches "
+                            f"(a device of {known_from}'s masses in kg): probably mm (in m it "
+                            f"would move at {rms / 1000:.3g} m/s); {name} must be in m",
+                            column=name)
+        if rms > MAX_VELOCITY_RMS:
+            out.append(CheckWarning(str(source), "unit", f"{name} moves at {rms:.3g} m/s RMS "
+                                    f"(its derivative), faster than the {MAX_VELOCITY_RMS:g} "
+                                    "m/s a shaker or rig reaches: in mm? (in m it would move "
+                                    f"at {rms / 1000:.3g} m/s); {name} must be in m, unless "
+                                    "the device is not mechanical (a circuit in volts)",
+                                    column=name))
+    return out
+
+
+def drifting_base(df: pd.DataFrame, kinds: RecordingKinds, dt: float,
+                  source: str | Path) -> list[CheckWarning]:
+    """A warning when a base displacement drifts (``harvester.data.kinds.drift``): its
+    straight-line change over the record is more than DRIFT_SHARE of its RMS oscillation.
+    A straight line has no acceleration, so the model's base acceleration is unchanged; a
+    curved drift (a sensor warming up) adds a slow acceleration below the analysed band."""
+    from harvester.data.kinds import DRIFT_SHARE, drift
+    if kinds.input_kind != "base_disp":
+        return []
+    d = drift(df["base_disp"].to_numpy(dtype=float), dt)
+    if not d.drifting:
+        return []
+    return [CheckWarning(str(source), "drift", f"the base displacement drifts by "
+                         f"{d.drift:.4g} m over {d.seconds:.3g} s (straight-line fit; mean "
+                         f"{d.start:.4g} m over the first tenth, {d.end:.4g} m over the last), "
+                         f"{d.share:.2g} times its RMS oscillation about that line "
+                         f"({d.oscillation:.4g} m; more than {DRIFT_SHARE:g} is reported): a "
+                         "drifting sensor (a laser or LVDT warming up, a mount that slipped) "
+                         "or a base that moved; a straight drift leaves base_acc unchanged, a "
+                         "curved one adds a slow acceleration", column="base_disp")]
 
 
 # --------------------------------------------------------------------------- entry points
@@ -394,6 +544,8 @@ def check_recording(df: pd.DataFrame, kinds: RecordingKinds, dt: float, source: 
     found = saturation(df, kinds, dt, source, lines)
     found += flat_stretches(df, kinds, dt, source, lines)
     found += spikes(df, kinds, source, lines)
+    found += drifting_base(df, kinds, dt, source)
+    found += fast_displacements(df, kinds, dt, source, known, known_from)
     found += check_clock_against_device(dt, known, source, known_from)
     found += check_units_by_physics(df, kinds, dt, known, source, known_from, lowpass_hz)
     return found

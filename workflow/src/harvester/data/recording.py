@@ -8,6 +8,8 @@ its column names what drives the device and what was measured:
 column     unit   meaning
 ========== ====== ===================================================================
 base_acc   m/s^2  input: base acceleration y'' (eq. 1 driven by -m y'')
+base_disp  m      input: base displacement y (laser, LVDT), zero-phase differentiated twice
+                  into y'' for the model (``harvester.data.kinds``)
 force      N      input: force on the mass, base fixed (eq. 1 driven by F; m unused)
 rel_acc    m/s^2  output: z'' = x'' - y'', the mass's acceleration relative to the base
 rel_disp   m      output: z, the mass's displacement relative to the base (to ground
@@ -15,6 +17,8 @@ rel_disp   m      output: z, the mass's displacement relative to the base (to gr
 ========== ====== ===================================================================
 
 Exactly one input and one output column; other numeric columns are carried along unused.
+What each kind means to the model and to the diagnosis is its object in
+``harvester.data.kinds``.
 
 Units are SI only. A column that says it is in another unit (``rel_disp_mm``, ``base_acc [g]``,
 ``force_kN``) is reported, never converted silently, and so are values that only make sense in
@@ -44,6 +48,7 @@ G = 9.80665
 INPUT_KINDS: dict[str, tuple[str, str]] = {
     "base_acc": ("m/s^2", "base acceleration y''"),
     "force": ("N", "force on the mass, base fixed"),
+    "base_disp": ("m", "base displacement y (laser, LVDT)"),
 }
 #: Output kinds: column name -> (SI unit, meaning).
 OUTPUT_KINDS: dict[str, tuple[str, str]] = {
@@ -72,13 +77,14 @@ _NON_SI = {
 }
 _SI = {"m/s^2", "m/s2", "ms-2", "m/s/s", "m", "n"}
 _ANNOTATED = re.compile(
-    r"^\s*(?P<kind>base_acc|force|rel_acc|rel_disp)[\s_\-]*[\[(]?\s*"
+    r"^\s*(?P<kind>base_acc|base_disp|force|rel_acc|rel_disp)[\s_\-]*[\[(]?\s*"
     r"(?P<unit>[^\])\s]+)\s*[\])]?\s*$", re.IGNORECASE)
 
 
 @dataclass(frozen=True)
 class RecordingKinds:
-    """The input kind ('base_acc' | 'force') and output kind ('rel_acc' | 'rel_disp')."""
+    """The input kind ('base_acc' | 'base_disp' | 'force') and output kind ('rel_acc' |
+    'rel_disp')."""
 
     input_kind: str
     output_kind: str
@@ -160,7 +166,9 @@ def check_plausible(df: pd.DataFrame, kinds: RecordingKinds,
       :data:`MAX_VELOCITY_CHANGE`: gravity left in, in m/s^2 or in g. (A relative velocity and
       a shaker's velocity stay bounded, so their accelerations average to ~0 over a long
       record; a smaller mean is left alone, as an accelerometer's bias may give one.)
-    * displacement (rel_disp) beyond :data:`MAX_DISPLACEMENT_M`: mm (or another small unit).
+    * displacement (rel_disp, base_disp) beyond :data:`MAX_DISPLACEMENT_M`: mm (or another
+      small unit); one that moves faster than a rig can is a warning
+      (``checks.fast_displacements``: a circuit in volts may).
     """
     t = df["time"].to_numpy(dtype=float)
     duration = float(t[-1] - t[0]) if t.size > 1 else 0.0
@@ -176,7 +184,7 @@ def check_plausible(df: pd.DataFrame, kinds: RecordingKinds,
                                     f"change the velocity by {abs(mean) * duration:.3g} m/s: "
                                     f"looks like gravity left in, in {unit}; {name} must be "
                                     "in m/s^2 with gravity removed", column=name)
-        elif name == "rel_disp":
+        elif name in ("rel_disp", "base_disp"):
             peak = float(np.max(np.abs(x)))
             if peak > MAX_DISPLACEMENT_M:
                 raise DataError(source, f"displacement up to {peak:.4g}: more than "

@@ -23,7 +23,8 @@ from harvester.data.errors import DataError
 from harvester.data.input_noise import NoiseFloor, noise_floor, without_floor
 from harvester.data.signals import resample_recording, resampling_ratio, uniform_step
 from harvester.diagnosis.baseline import ChainProblem, baseline_state, chain_problem, fit_map
-from harvester.diagnosis.confirm import ModelFit, fit_structure, map_reference
+from harvester.diagnosis.confirm import fit_structure, map_reference
+from harvester.diagnosis.fits import ModelFit
 from harvester.diagnosis.detect import band_top, estimate_temper
 from harvester.diagnosis.settings import DiagnosisSettings
 from harvester.diagnosis.spectral import filter_cutoff
@@ -46,22 +47,44 @@ V_BOUND_MARGIN = 3.0
 
 def check_recording(df: pd.DataFrame, source: str = "<recording>", lead_in_s: float = 1.0,
                     holdout_fraction: float = 0.25) -> tuple[pd.DataFrame, float]:
-    """The recording's columns, values and time base; returns (recording, dt in s).
+    """The recording's columns, values and time base; returns (recording: time, its input
+    and its output column, dt in s).
 
-    It must hold the lead-in, MIN_ANALYSIS_S analysed seconds (plus the held-out share,
-    ``holdout_fraction``, 0 when a validation record is given) and 0.5 s of filter end effects.
-    The checks are ``harvester.data.checks``'s (also absurd magnitudes and dead channels).
+    Any kind of recording (``harvester.data.kinds``): input base_acc, base_disp or force,
+    output rel_acc or rel_disp. It must hold the lead-in, MIN_ANALYSIS_S analysed seconds
+    (plus the held-out share, ``holdout_fraction``, 0 when a validation record is given) and
+    0.5 s of filter end effects. The checks are ``harvester.data.checks``'s (also absurd
+    magnitudes and dead channels).
     """
     from harvester.data.checks import (check_duration, check_frame, check_live_channels,
                                        check_magnitudes)
-    from harvester.data.recording import RecordingKinds
-    dt = check_frame(df, source, RECORDING_COLUMNS)
-    kinds = RecordingKinds("base_acc", "rel_acc")
+    from harvester.data.recording import recording_kinds
+    if not isinstance(df, pd.DataFrame):
+        check_frame(df, source, RECORDING_COLUMNS)  # names what a table needs
+    kinds = recording_kinds(df, source)
+    columns = ("time", kinds.input_kind, kinds.output_kind)
+    dt = check_frame(df, source, columns)
     check_magnitudes(df, kinds, source)
     check_live_channels(df, kinds, source)
     check_duration(df, dt, source, lead_in_s, MIN_ANALYSIS_S, holdout_fraction)
-    out = df[list(RECORDING_COLUMNS)].astype(float).reset_index(drop=True)
+    out = df[list(columns)].astype(float).reset_index(drop=True)
     return out, dt
+
+
+def model_kinds(rec: pd.DataFrame, validation: pd.DataFrame | None, lowpass_hz: float | None,
+                source: str, notes: list[str]) -> tuple[pd.DataFrame, pd.DataFrame | None]:
+    """The recordings in the kinds the model takes (``harvester.data.kinds.model_recording``:
+    a base displacement differentiated into a base acceleration, band-limited at the
+    recording's low-pass); copies, with what was done appended to ``notes``."""
+    from harvester.data.kinds import model_recording
+    rec, done = model_recording(rec, lowpass_hz, source)
+    if validation is not None:
+        validation, more = model_recording(validation, lowpass_hz, "<validation>")
+        done += more
+    for line in done:
+        log.info("%s", line)
+    notes.extend(done)
+    return rec, validation
 
 
 def resample_for_model(rec: pd.DataFrame, validation: pd.DataFrame | None, dt: float,
@@ -144,8 +167,12 @@ def prepare(recording: pd.DataFrame, validation: pd.DataFrame | None,
     if validation is not None:
         validation, _ = check_recording(validation, "<validation>", settings.lead_in_s, 0.0)
     base = named_structure(baseline) if isinstance(baseline, str) else baseline
-    lowpass = settings.lowpass_hz or filter_cutoff(rec["rel_acc"].to_numpy(), 1.0 / dt)
+    output = rec.columns[2]  # check_recording: time, input, output
+    lowpass = settings.lowpass_hz or filter_cutoff(rec[output].to_numpy(), 1.0 / dt)
+    kind_notes: list[str] = []
+    rec, validation = model_kinds(rec, validation, lowpass, source, kind_notes)
     rec, validation, dt, notes = resample_for_model(rec, validation, dt, lowpass)
+    notes[:0] = kind_notes
     fs, n = 1.0 / dt, len(rec)
     floor = None
     if settings.denoise_input:
@@ -182,17 +209,18 @@ def analysis_window(n: int, fs: float, lead_in_s: float, holdout_fraction: float
 
 def model_input(rec: pd.DataFrame, validation: pd.DataFrame | None, fs: float, f_high: float,
                 notes: list[str]) -> tuple[pd.DataFrame, pd.DataFrame | None, NoiseFloor | None]:
-    """The recordings with the base acceleration the models are driven by: without its bins
-    on the channel's noise floor where it shows one below ``f_high`` Hz
-    (:mod:`harvester.data.input_noise`; the validation record with the training record's
-    floor), else as recorded. Copies; the recordings passed in are not changed."""
-    floor = noise_floor(rec["base_acc"].to_numpy(), fs, f_high)
+    """The recordings with the input the models are driven by (their second column: a base
+    acceleration or a force): without its bins on the channel's noise floor where it shows
+    one below ``f_high`` Hz (:mod:`harvester.data.input_noise`; the validation record with
+    the training record's floor), else as recorded. Copies; the recordings passed in are not
+    changed."""
+    name = rec.columns[1]
+    floor = noise_floor(rec[name].to_numpy(), fs, f_high)
     if floor is None:
         return rec, validation, None
-    out = [r if r is None else r.assign(base_acc=without_floor(r["base_acc"].to_numpy(), fs,
-                                                                floor))
+    out = [r if r is None else r.assign(**{name: without_floor(r[name].to_numpy(), fs, floor)})
            for r in (rec, validation)]
-    line = (f"base_acc shows a white noise floor of {floor.rms:.3g} RMS over "
+    line = (f"{name} shows a white noise floor of {floor.rms:.3g} RMS over "
             f"{floor.band_hz[0]:.2g}-{floor.band_hz[1]:.3g} Hz ({floor.share:.0%} of the band, "
             f"{floor.dynamic_range:.3g} x below its strongest line): the models are driven by "
             "its bins above that floor, so that the input's noise does not reach the residual "
@@ -202,11 +230,13 @@ def model_input(rec: pd.DataFrame, validation: pd.DataFrame | None, fs: float, f
     return out[0], out[1], floor
 
 
-def default_priors(structure: ModelStructure, sigma: float) -> dict[str, PriorSpec]:
+def default_priors(structure: ModelStructure, sigma: float, unit: str = "m/s^2"
+                   ) -> dict[str, PriorSpec]:
     """Library priors of the structure's parameters, sigma ~ TN(s, s) with s the MAP's RMS
-    residual (the noise level differs between rigs; every model shares this prior)."""
+    residual (the noise level differs between rigs; every model shares this prior), in
+    ``unit``, the output kind's."""
     out = {n: default_prior(n) for n in structure.free_parameters}
-    out["sigma"] = PriorSpec("sigma", sigma, sigma, "m/s^2", 0.0)
+    out["sigma"] = PriorSpec("sigma", sigma, sigma, unit, 0.0)
     return out
 
 
@@ -246,7 +276,8 @@ def start_baseline(analysis: Analysis, priors: Mapping[str, PriorSpec] | None,
     if posterior is None:
         mp = fit_map(a.chain(a.fit_raw, 1.0), priors, seed=settings.seed)
         a.detection_raw.v_bound = a.fit_raw.v_bound = velocity_bound(a.detection_raw, mp.theta)
-        specs = {**default_priors(a.structure, float(mp.theta[-1])), **priors}
+        specs = {**default_priors(a.structure, float(mp.theta[-1]),
+                                  a.fit_raw.output_type.unit), **priors}
         temper = estimate_temper(mp.residual, a.fit_window, a.fs, a.f_high)
         log.info("tempering lambda = %.3f (%.1f correlated samples per independent one)",
                  temper, 1.0 / temper)
@@ -259,7 +290,8 @@ def start_baseline(analysis: Analysis, priors: Mapping[str, PriorSpec] | None,
     samples = _posterior_samples(posterior, a.detection_raw.parameter_names)
     a.detection_raw.v_bound = a.fit_raw.v_bound = velocity_bound(a.detection_raw,
                                                                  samples.mean(axis=0))
-    specs = {**default_priors(a.structure, float(np.mean(samples[:, -1]))), **priors}
+    specs = {**default_priors(a.structure, float(np.mean(samples[:, -1])),
+                              a.fit_raw.output_type.unit), **priors}
     state = baseline_state(a.chain(a.detection_raw, 1.0), samples)
     temper = estimate_temper(state.residual, a.window, a.fs, a.f_high)
     ev = float(np.mean(idata_log_evidence(posterior))) \

@@ -103,15 +103,17 @@ class ChainProblem(Problem):
         return self._observed_chain
 
     def predicted(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(z'' through the chain over the whole record (N, n), ok (N,)) for rows of theta."""
+        """(the output through the chain over the whole record (N, n), ok (N,)) for rows of
+        theta: z'' or z as the recording's output kind says (``OutputKind.simulated``)."""
         sim = self.simulate(np.atleast_2d(theta))
-        acc = np.where(sim.ok[:, None], sim.rel_acc, 0.0)
+        acc = np.where(sim.ok[:, None], self.output_type.simulated(sim), 0.0)
         out = self.chain(acc)
         out[~sim.ok] = np.nan
         return out, sim.ok
 
     def residuals(self, theta: np.ndarray) -> np.ndarray:
-        """Measured minus predicted z'' over the window, both through the chain (N, n_data)."""
+        """Measured minus predicted output over the window, both through the chain
+        (N, n_data)."""
         pred, _ = self.predicted(theta)
         return self.observed[None, :] - pred[:, self.samples]
 
@@ -140,6 +142,7 @@ def chain_problem(problem: Problem, temper: float = 1.0, lowpass_hz: float | Non
     end = min(len(problem.rel_acc), stop + int(round(CHAIN_PAD_S / problem.dt)))
     return ChainProblem(structure or problem.structure, problem.base_acc[:end],
                         problem.rel_acc[:end], problem.dt, dict(problem.known), (start, stop),
+                        input_kind=problem.input_kind, output_kind=problem.output_kind,
                         temper=float(temper), v_bound=problem.v_bound, lowpass_hz=lowpass_hz,
                         filter_order=filter_order, oversample=DAQ_OVERSAMPLE,
                         band_fraction=band_fraction)
@@ -387,11 +390,11 @@ def laplace_log_evidence(coords: PriorCoordinates, u: np.ndarray, fisher: np.nda
 
 
 def sensitivities(problem: ChainProblem, theta: np.ndarray, scale: np.ndarray) -> np.ndarray:
-    """d z''(t) / d theta_j (through the chain) over the record by central differences.
+    """d output(t) / d theta_j (through the chain) over the record by central differences.
 
     theta: (free physical parameters..., sigma); scale: a typical spread of each free
     parameter (posterior sd); the step is 0.05 scale. One batched simulation.
-    Returns (samples, P) in m/s^2 per unit of each parameter.
+    Returns (samples, P) in the output's unit per unit of each parameter.
     """
     theta = np.asarray(theta, dtype=float)
     p = len(problem.structure.free_parameters)
@@ -412,9 +415,10 @@ def sensitivities(problem: ChainProblem, theta: np.ndarray, scale: np.ndarray) -
 class BaselineState:
     """The baseline at its posterior mean: simulated state, residual and sensitivities.
 
-    All arrays over the problem's (possibly shortened) record; z'' and the residual through
-    the measurement chain; ``theta`` = (free parameters..., sigma); ``theta_sd`` the posterior
-    sd of each; ``samples`` posterior draws (rows like theta).
+    All arrays over the problem's (possibly shortened) record; z'', the model's output (of
+    the recording's output kind: z'' or z, ``harvester.data.kinds``) and the residual through
+    the measurement chain; ``theta`` = (free parameters..., sigma); ``theta_sd`` the
+    posterior sd of each; ``samples`` posterior draws (rows like theta).
     """
 
     problem: ChainProblem
@@ -426,6 +430,11 @@ class BaselineState:
     rel_acc: np.ndarray
     residual: np.ndarray
     jacobian: np.ndarray = field(repr=False)
+    output: np.ndarray | None = field(default=None, repr=False)  # None: rel_acc is the output
+
+    def __post_init__(self) -> None:
+        if self.output is None:
+            self.output = self.rel_acc
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -440,7 +449,8 @@ def baseline_state(problem: ChainProblem, samples: np.ndarray) -> BaselineState:
     sim = problem.simulate(theta)
     if not sim.ok[0]:
         raise RuntimeError(f"the posterior mean of {problem.structure.name} cannot be simulated")
-    model = problem.chain(sim.rel_acc[0])
+    model = problem.chain(problem.output_type.simulated(sim)[0])
     jac = sensitivities(problem, theta, sd)
     return BaselineState(problem, theta, sd, samples, sim.rel_disp[0], sim.rel_vel[0],
-                         model, problem.measured_chain - model, jac)
+                         problem.chain(sim.rel_acc[0]), problem.measured_chain - model, jac,
+                         model)

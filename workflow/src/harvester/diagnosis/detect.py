@@ -305,8 +305,9 @@ def filter_artifacts(state: BaselineState, frame: Frame, count: int,
         if not all(s.ok[0] for s in sims):
             out[i] = 0.0
             continue
-        data = problem.chain(problem.recording_filter(sims[0].rel_acc[0]))
-        model = problem.chain(sims[1].rel_acc[0])
+        output = problem.output_type.simulated  # the recording's output kind
+        data = problem.chain(problem.recording_filter(output(sims[0])[0]))
+        model = problem.chain(output(sims[1])[0])
         out[i] = frame.dft(data - model)
     return out
 
@@ -457,8 +458,8 @@ def where(state: BaselineState, w: Whitened, stationary: np.ndarray, time: np.nd
     windows = TimeWindows(frame, time, settings.window_s)
     w_stats = standardise(windows.statistic(series), windows.statistic(series_rep))
     regions = StateRegions(frame, state.rel_disp, state.rel_vel, state.rel_acc,
-                           state.problem.base_acc)
-    standstill = MeasuredStandstill(frame, state.rel_acc)
+                           state.problem.base_acc, state.problem.input_type)
+    standstill = MeasuredStandstill(frame, state.output, state.problem.output_type)
     # the regions' statistics are log(energy share); the standstill's is log(share / time
     # share) (its mask moves with the data), put on the same footing for the gate below
     obs = np.append(regions.statistic(series), standstill.statistic(series))
@@ -479,7 +480,7 @@ def region_gains(frame: Frame, state: BaselineState, regions: StateRegions,
                  ) -> Standardised:
     """Amplitude ratio measured / model in each region, 1 + <r, m> / <m, m> (0: the data do
     not move where the model does, as when the real device sticks)."""
-    model_band = frame.band_limited(frame.dft(state.rel_acc))
+    model_band = frame.band_limited(frame.dft(state.output))
 
     def gains(res: np.ndarray) -> np.ndarray:
         if res.ndim == 1:

@@ -17,6 +17,14 @@ from harvester.plots.style import save_figure  # noqa: E402
 log = logging.getLogger("harvester.diagnosis")
 
 
+def _output(diag) -> tuple[str, str]:
+    """(symbol, unit) of the recording's output kind for axis labels."""
+    kind = diag.rounds[0].state.problem.output_type if diag.rounds else None
+    if kind is None or kind.order == 2:
+        return "$\\ddot z$", "m/s$^2$"
+    return "$z$", "m"
+
+
 def residual_windows(diag, path: Path) -> Path:
     """Band-limited residual over time, windows with excess energy shaded."""
     det = diag.rounds[0].detection
@@ -32,7 +40,8 @@ def residual_windows(diag, path: Path) -> Path:
             bx.axvspan(a, b, color="tab:red", alpha=0.15, lw=0)
     ax.plot(t, det.residual_band, color="0.55", lw=0.6, label="residual (measured - model mean)")
     ax.plot(t, det.explained_band, color="k", lw=0.8, label="part explained by the candidates")
-    ax.set_ylabel("$\\ddot z$ residual (m/s$^2$)")
+    symbol, unit = _output(diag)
+    ax.set_ylabel(f"{symbol} residual ({unit})")
     ax.set_title(f"{diag.baseline.name}: residual in {det.frame.f_low:g}-{det.frame.f_high:.1f} Hz"
                  f" (shaded: windows holding significantly more energy)", fontsize=10)
     ax.legend(loc="upper right", fontsize=8, frameon=False)
@@ -71,7 +80,7 @@ def state_regions(diag, path: Path) -> Path:
         ax.plot(0.5 * (edges[1:] + edges[:-1]), np.sqrt(ms), "o-", color="k", ms=3)
         ax.axhline(np.sqrt(np.mean(e)), color="0.5", lw=0.8, ls="--", label="overall")
         ax.set_xlabel(label + " (model)")
-        ax.set_ylabel("RMS residual (m/s$^2$)")
+        ax.set_ylabel(f"RMS residual ({_output(diag)[1]})")
         ax.legend(fontsize=8, frameon=False)
     axes[1].set_title("where the residual lives in the motion", fontsize=10)
     return save_figure(fig, path)
@@ -99,7 +108,7 @@ def frequency_bands(diag, path: Path) -> Path:
                 label="white noise at the residual's median level")
     ax.set_ylim(0.3 * min(np.min(p_res), floor), 3 * max(np.max(p_res), floor))
     ax.set_xlabel("frequency (Hz)")
-    ax.set_ylabel("PSD ((m/s$^2$)$^2$/Hz)")
+    ax.set_ylabel(f"PSD (({_output(diag)[1]})$^2$/Hz)")
     ax.set_title("residual spectrum (shaded: bands where the candidates explain significant "
                  "energy)", fontsize=10)
     ax.legend(fontsize=8, frameon=False)
@@ -151,7 +160,7 @@ def before_after(diag, path: Path, seconds: float = 6.0) -> Path:
                         alpha=0.2, lw=0, label="mean $\\pm$3 sd (predictive)")
         ax.plot(t, u.measured[sel], color="0.6", lw=1.0, label=f"measured ({u.data})")
         ax.plot(t, u.mean[sel], color="k", lw=0.9, label="model mean")
-        ax.set_ylabel("$\\ddot z$ (m/s$^2$)")
+        ax.set_ylabel("{} ({})".format(*_output(diag)))
         ax.set_title(f"{title}: NRMSE {u.nrmse:.3f}, {100 * u.coverage_3sigma:.1f} % inside "
                      "3 sd", fontsize=10)
         ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)

@@ -104,8 +104,13 @@ class StateRegions:
     """Regions of the baseline's simulated motion (boolean masks over the analysis window)."""
 
     def __init__(self, frame: Frame, rel_disp: np.ndarray, rel_vel: np.ndarray,
-                 rel_acc: np.ndarray, base_acc: np.ndarray,
+                 rel_acc: np.ndarray, base_acc: np.ndarray, input_kind=None,
                  quantile: float = REGION_QUANTILE) -> None:
+        """``base_acc``: the model's input (a force for a force input), ``input_kind`` its
+        ``harvester.data.kinds.InputKind`` (None: a base acceleration), which names the
+        region where it is large."""
+        from harvester.data.kinds import input_kind as kind_of
+        kind = input_kind or kind_of("base_acc")
         sl = slice(frame.start, frame.stop)
         z = rel_disp[sl] - np.median(rel_disp[sl])
         v, a, y = rel_vel[sl], rel_acc[sl], base_acc[sl]
@@ -117,7 +122,7 @@ class StateRegions:
             "large_displacement": az >= np.quantile(az, hi),
             "small_displacement": az <= np.quantile(az, lo),
             "large_acceleration": aa >= np.quantile(aa, hi),
-            "large_base_acceleration": ay >= np.quantile(ay, hi),
+            kind.region_name: ay >= np.quantile(ay, hi),
             "positive_velocity": v > 0,
             "negative_velocity": v < 0,
             "positive_displacement": z > 0,
@@ -130,7 +135,7 @@ class StateRegions:
             "large_displacement": f"|z| above its {hi:.0%} quantile (end stops, stiffness)",
             "small_displacement": f"|z| below its {lo:.0%} quantile (near the rest position)",
             "large_acceleration": f"|z''| above its {hi:.0%} quantile (inertia, modes)",
-            "large_base_acceleration": f"|y''| above its {hi:.0%} quantile",
+            kind.region_name: kind.region.format(hi=hi),
             "positive_velocity": "z' > 0 (mass moving up)",
             "negative_velocity": "z' < 0 (mass moving down)",
             "positive_displacement": "z above its median",
@@ -193,20 +198,26 @@ STANDSTILL_HALF_S = 0.02
 
 
 class MeasuredStandstill:
-    """Where the MEASURED relative acceleration stays near zero for a while: the mass moving
+    """Where the MEASURED relative motion stays near zero for a while: the mass moving
     with the base (friction sticking), whatever the model does there.
 
-    Samples whose running maximum of |z''| over +-STANDSTILL_HALF_S is below that maximum's
-    ``quantile``; the mask depends on the data, so it is recomputed for each replicate
-    (model + replicate residual), which calibrates the selection.
+    Samples whose running maximum of |z''| (of |z'| for a displacement output: the output
+    kind's ``motion``, ``harvester.data.kinds``) over +-STANDSTILL_HALF_S is below that
+    maximum's ``quantile``; the mask depends on the data, so it is recomputed for each
+    replicate (model + replicate residual), which calibrates the selection.
     """
 
     name = "measured_standstill"
-    description = ("measured |z''| near zero for 40 ms or more (the mass moving with the "
-                   "base: sticking)")
 
-    def __init__(self, frame: Frame, model: np.ndarray, quantile: float = REGION_QUANTILE
-                 ) -> None:
+    def __init__(self, frame: Frame, model: np.ndarray, output_kind=None,
+                 quantile: float = REGION_QUANTILE) -> None:
+        """``model``: the model's output through the chain, of ``output_kind``
+        (``harvester.data.kinds.OutputKind``; None: z'')."""
+        from harvester.data.kinds import output_kind as kind_of
+        self.kind = output_kind or kind_of("rel_acc")
+        self.dt = 1.0 / frame.fs
+        self.description = (f"measured |{self.kind.motion_symbol}| near zero for 40 ms or "
+                            "more (the mass moving with the base: sticking)")
         self.model = model[frame.start:frame.stop] * frame.taper
         self.width = max(3, int(round(2 * STANDSTILL_HALF_S * frame.fs)) | 1)
         self.quantile = quantile
@@ -214,7 +225,8 @@ class MeasuredStandstill:
 
     def mask(self, series: np.ndarray) -> np.ndarray:
         from scipy import ndimage
-        peak = ndimage.maximum_filter1d(np.abs(self.model + series), self.width, axis=-1)
+        motion = self.kind.motion(self.model + series, self.dt)
+        peak = ndimage.maximum_filter1d(np.abs(motion), self.width, axis=-1)
         return peak <= np.quantile(peak, self.quantile, axis=-1, keepdims=True)
 
     def statistic(self, series: np.ndarray) -> np.ndarray:

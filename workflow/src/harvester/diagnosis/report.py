@@ -7,7 +7,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from harvester.diagnosis.baseline import ChainProblem
-from harvester.diagnosis.confirm import prior_dict
+from harvester.diagnosis.fits import prior_dict
 from harvester.inference.predictive import nrmse, outside_fraction, thin
 
 
@@ -46,10 +46,14 @@ class UnseenFit:
 def unseen_fit(problem: ChainProblem, samples: np.ndarray, base_acc: np.ndarray,
                rel_acc: np.ndarray, time: np.ndarray, section: tuple[int, int], data: str,
                count: int = 100, seed: int = 0) -> UnseenFit:
-    """Posterior predictive of ``problem``'s structure for a record, over ``section``."""
+    """Posterior predictive of ``problem``'s structure for a record, over ``section``.
+
+    ``base_acc``, ``rel_acc``: the record's input and output, of ``problem``'s kinds (the
+    paper-case names; a force and a displacement too)."""
     theta = thin(samples, count, seed)
     record = ChainProblem(problem.structure, base_acc, rel_acc, problem.dt, dict(problem.known),
-                          (section[0], section[1]), temper=problem.temper,
+                          (section[0], section[1]), input_kind=problem.input_kind,
+                          output_kind=problem.output_kind, temper=problem.temper,
                           lowpass_hz=problem.lowpass_hz, filter_order=problem.filter_order,
                           oversample=problem.oversample, band_fraction=problem.band_fraction)
     pred, ok = record.predicted(theta)
@@ -216,8 +220,14 @@ def _rounds(d) -> list[dict]:
 def _diagnosis_dict(d) -> dict:
     first = d.rounds[0]
     s = d.settings
+    judged = d.fit_judgement
     return {
         "verdict": d.verdict,
+        "headline": d.headline,
+        "explained_share": None if judged is None else judged.explained,
+        "unseen_nrmse": None if judged is None else judged.nrmse,
+        "noise_floor": None if judged is None or judged.floor is None else judged.floor.to_dict(),
+        "fit_judgement": None if judged is None else judged.to_dict(s.floor_ratio),
         "missing": d.missing,
         "indistinguishable": d.indistinguishable,
         "ties": [tie.to_dict() for tie in d.ties],

@@ -22,18 +22,20 @@ import pandas as pd
 
 from harvester.data.signals import uniform_step
 from harvester.diagnosis.analysis import (Analysis, BaselineStart, check_recording,
-                                          default_priors, model_input, prepare,
+                                          default_priors, model_input, model_kinds, prepare,
                                           resample_for_model,
                                           start_baseline, velocity_bound)
 from harvester.diagnosis.baseline import BaselineState, baseline_state, chain_problem, fit_map
-from harvester.diagnosis.confirm import ModelFit
+from harvester.diagnosis.fits import ModelFit
 from harvester.diagnosis.detect import Detection, band_top, detect, estimate_temper
 from harvester.diagnosis.report import UnseenFit, unseen_fit
 from harvester.diagnosis.rounds import Round, run_rounds
 from harvester.diagnosis.settings import DiagnosisSettings
 from harvester.diagnosis.signatures import candidate_terms
 from harvester.diagnosis.spectral import filter_cutoff
-from harvester.diagnosis.verdict import Conclusion, Tie, conclude, decide_verdict
+from harvester.diagnosis.floor import output_floor
+from harvester.diagnosis.verdict import (Conclusion, FitJudgement, Tie, conclude,
+                                          decide_verdict, judge)
 from harvester.inference.problems import make_problem
 from harvester.inference.priors import PriorSpec
 from harvester.model.structures import ModelStructure
@@ -75,6 +77,8 @@ class Diagnosis:
     time: np.ndarray = field(repr=False)
     notes: list[str] = field(default_factory=list)
     figure_files: list[str] = field(default_factory=list)
+    headline: str = ""
+    fit_judgement: FitJudgement | None = None
 
     @property
     def indistinguishable(self) -> list[list[str]]:
@@ -108,11 +112,12 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
     found = conclude(rounds, unexplained, settings, analysis.f_high)
     before, after, unseen_notes = unseen_comparison(analysis, start, found.improved_fit,
                                                     settings)
+    found = judge(found, rounds[0].detection, fit_judgement(start, rounds[0], before, after),
+                  analysis.structure.name, settings)
     diag = _diagnosis(analysis, start, rounds, baseline_fit, found, (before, after), settings,
                       analysis.notes + notes + found.notes + unseen_notes,
                       time.perf_counter() - clock)
-    log.info("verdict: %s%s%s (%.0f s)", diag.verdict,
-             f"; missing {', '.join(diag.missing)}" if diag.missing else "",
+    log.info("verdict: %s%s (%.0f s)", diag.headline,
              "".join(f"; cannot tell apart {' / '.join(t.effects)}" for t in diag.ties),
              diag.seconds)
     if out_dir is not None:
@@ -136,7 +141,23 @@ def _diagnosis(a: Analysis, start: BaselineStart, rounds: list[Round],
         lowpass_hz=a.lowpass, likelihood_lowpass_hz=start.detection_problem.band_hz,
         window_s=(float(t[a.lead]), float(t[a.hold - 1])),
         fit_window_s=(float(t[a.lead]), float(t[a.fit_stop - 1])), settings=settings,
-        priors=start.priors, seconds=seconds, time=t, notes=notes)
+        priors=start.priors, seconds=seconds, time=t, notes=notes, headline=found.headline,
+        fit_judgement=found.fit)
+
+
+def fit_judgement(start: BaselineStart, first: Round, before: UnseenFit | None,
+                  after: UnseenFit | None) -> FitJudgement:
+    """The baseline's share of the unseen output explained (1 - NRMSE^2), the improved
+    model's, and the baseline's residual over the analysed window against the recording's own
+    noise floor in the likelihood's band (``floor.output_floor``)."""
+    p = start.detection_problem
+    found = output_floor(p.base_acc, p.rel_acc, p.measured_chain, p.window, 1.0 / p.dt,
+                         p.band_hz)
+    share = None if before is None else 1.0 - before.nrmse ** 2
+    improved = None if after is None else 1.0 - after.nrmse ** 2
+    return FitJudgement(share, None if before is None else before.nrmse,
+                        None if before is None else before.data, first.detection.sigma, found,
+                        improved)
 
 
 def unseen_comparison(a: Analysis, start: BaselineStart, improved: ModelFit | None,
@@ -147,11 +168,11 @@ def unseen_comparison(a: Analysis, start: BaselineStart, improved: ModelFit | No
     if a.validation is not None:
         v = a.validation
         lead = int(round(settings.lead_in_s / a.dt))
-        u, y, t = v["base_acc"].to_numpy(), v["rel_acc"].to_numpy(), v["time"].to_numpy()
+        u, y, t = v.iloc[:, 1].to_numpy(), v.iloc[:, 2].to_numpy(), v["time"].to_numpy()
         section, data = (lead, len(v) - int(round(0.5 * a.fs))), "validation"
     elif a.hold < a.end - 8:
         rec = a.recording
-        u, y, t = rec["base_acc"].to_numpy(), rec["rel_acc"].to_numpy(), a.time
+        u, y, t = rec.iloc[:, 1].to_numpy(), rec.iloc[:, 2].to_numpy(), a.time
         section, data = (a.hold, a.end), "holdout"
     else:
         return None, None, []
@@ -175,7 +196,8 @@ def quick_detect(recording: pd.DataFrame, baseline: str | ModelStructure,
     recordings. The whole recording after the lead-in is analysed (nothing held out)."""
     rec, dt = check_recording(recording, "<recording>", settings.lead_in_s, 0.0)
     base = named_structure(baseline) if isinstance(baseline, str) else baseline
-    lowpass = settings.lowpass_hz or filter_cutoff(rec["rel_acc"].to_numpy(), 1.0 / dt)
+    lowpass = settings.lowpass_hz or filter_cutoff(rec.iloc[:, 2].to_numpy(), 1.0 / dt)
+    rec, _ = model_kinds(rec, None, lowpass, "<recording>", [])
     rec, _, dt, _ = resample_for_model(rec, None, dt, lowpass)
     fs = 1.0 / dt
     if settings.denoise_input:
@@ -188,24 +210,30 @@ def quick_detect(recording: pd.DataFrame, baseline: str | ModelStructure,
         temper = estimate_temper(mp.residual, raw.window, fs, band_top(fs, lowpass))
     problem = chain_problem(raw, temper, lowpass, settings.filter_order)
     mp = fit_map(problem, priors or {}, seed=settings.seed)
-    specs = {**default_priors(base, float(mp.theta[-1])), **(priors or {})}
+    specs = {**default_priors(base, float(mp.theta[-1]), problem.output_type.unit),
+             **(priors or {})}
     state = baseline_state(problem, mp.samples(200, settings.seed))
     det = detect(state, problem.window, specs, candidate_terms(base.terms, settings.candidates),
                  settings.detection(), time=rec["time"].to_numpy())
     return det, state
 
 
-def write(diag: Diagnosis, out_dir: str | Path) -> Path:
-    """diagnosis.json and the figures in ``out_dir``; returns the JSON's path."""
-    from harvester.data.fileio import write_json
+def write(diag: Diagnosis, out_dir: str | Path, title: str | None = None) -> Path:
+    """diagnosis.json, the figures and the summary page (``summary_page``, titled ``title``,
+    default "Diagnosis of BASELINE") in ``out_dir``; returns the JSON's path."""
+    from harvester.data.fileio import atomic_path, write_json
+    from harvester.diagnosis.summary_page import summary_page
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if diag.settings.figures:
         from harvester.diagnosis.figures import all_figures
         diag.notes.extend(all_figures(diag, out))
     path = out / "diagnosis.json"
-    write_json(diag.to_dict(), path)
-    log.info("wrote %s", path)
+    doc = diag.to_dict()
+    write_json(doc, path)
+    with atomic_path(out / "summary.html") as tmp:
+        tmp.write_text(summary_page(doc, out, title or f"Diagnosis of {diag.baseline.name}"))
+    log.info("wrote %s and summary.html", path)
     return path
 
 

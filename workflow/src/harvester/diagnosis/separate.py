@@ -11,9 +11,9 @@ the truth: A's posterior-mean response to u is the noise-free data, the rival B 
 it (its MAP in its prior coordinates, started from its posterior mean, ``baseline.fit_map``),
 and what B cannot follow is the evidence A would gain on such a recording,
 
-    gap_A(u) = lambda sum_t (z''_A(t) - z''_B*(t))^2 / (2 sigma^2)      (nats),
+    gap_A(u) = lambda sum_t (y_A(t) - y_B*(t))^2 / (2 sigma^2)      (nats),
 
-through the likelihood's low-pass, over a window as long as the one analysed, lambda and
+(y the output in the recording's kind, z'' or z) through the likelihood's low-pass, over a window as long as the one analysed, lambda and
 sigma the diagnosis's tempering and noise level (an expected log Bayes factor, the parameters'
 Occam factors left out). The experiment whose smaller gap (A true, or B true) is largest is
 the one recommended.
@@ -35,7 +35,8 @@ log = logging.getLogger("harvester.diagnosis")
 
 @dataclass(frozen=True)
 class Experiment:
-    """A proposed excitation: its name, what it is, and the base acceleration (m/s^2)."""
+    """A proposed excitation: its name, what it is, and the input in the model's input kind
+    (a base acceleration in m/s^2, or a force in N); the field keeps the paper-case name."""
 
     name: str
     description: str
@@ -95,7 +96,7 @@ def expected_gap(truth, rival, u: np.ndarray, sigma: float) -> float:
     sim = truth.problem.simulate(mean[None, :], input=u)
     if not sim.ok[0]:
         return float("nan")
-    problem = _on_input(rival, u, sim.rel_acc[0])
+    problem = _on_input(rival, u, truth.problem.output_type.simulated(sim)[0])
     start = rival.samples.mean(axis=0)[:-1]
     try:
         fit = fit_map(problem, rival.priors, n_starts=16, start=start)

@@ -1,10 +1,12 @@
-"""Output signatures of candidate effects: how z''(t) would change if the effect were present.
+"""Output signatures of candidate effects: how the output would change with the effect present.
 
 For a candidate term e of the physics library (``harvester.model.terms``) added to the baseline at its
 posterior mean, the signature is the secant
 
-    g_e(t) = (z''(theta, e at strength a) - z''(theta, e switched off)) / a
+    g_e(t) = (y(theta, e at strength a) - y(theta, e switched off)) / a
 
+with y the simulated output in the recording's kind (z'' or z, ``OutputKind.simulated`` of
+``harvester.data.kinds``), driven by its input kind (a base acceleration or a force),
 computed by the batched simulator, so it carries the full (nonlinear) dynamics of the
 baseline: a missing force is seen through the structure's response, not as a force. ``a`` is a
 small probe strength (a tenth of the damping force, a hundredth of the mass); for effects
@@ -44,7 +46,8 @@ def _centre(spec) -> float:
 class Signature:
     """The output signature of one candidate effect at one shape.
 
-    ``values`` (n_record,) is d z'' / d strength (m/s^2 per unit of ``strength``).
+    ``values`` (n_record,) is d output / d strength (the output's unit, m/s^2 or m, per
+    unit of ``strength``).
     """
 
     effect: str
@@ -69,8 +72,9 @@ def dissipative_force(base_acc: np.ndarray, rel_vel: np.ndarray, m: float) -> fl
     Eq. (1) times z', averaged: the kinetic and potential energy terms average to their
     end-point differences over the record, so the power dissipated equals the power the base
     puts in, <F_d z'> = -m <y'' z'>, whatever the split between viscous damping and friction.
-    A force input F(t) (N, EMPS-like drives) is ``base_acc=F, m=-1``. None when the
-    estimate is not positive (m unknown or 0, or no motion).
+    A force input F(t) (N, EMPS-like drives) is ``base_acc=F, m=-1``
+    (``InputKind.dissipative_force`` of ``harvester.data.kinds`` chooses for a recording's
+    kind). None when the estimate is not positive (m unknown or 0, or no motion).
     """
     v = np.asarray(rel_vel, dtype=float)
     power = -float(m) * float(np.mean(np.asarray(base_acc, dtype=float) * v))
@@ -93,8 +97,7 @@ def motion_scale(state: BaselineState, window: tuple[int, int], f_high: float) -
     zc = z - np.median(z)
     az = np.abs(zc)
     prob = state.problem
-    gain = prob.known.get("m", 0.0) if prob.input_kind == "base_acc" else -1.0  # force input
-    force = dissipative_force(prob.base_acc[start:stop], v, gain)
+    force = prob.input_type.dissipative_force(prob.input[start:stop], v, prob.known)
     values = dict(zip(prob.parameter_names, state.theta))
     masses = {n: float(prob.known.get(n, values.get(n, np.nan))) for n in ("M", "m", "k")}
     return DeviceScale(force=force or REFERENCE_DEVICE.force,
@@ -142,14 +145,16 @@ def signatures(state: BaselineState, scale: DeviceScale,
                 ref = len(rows)
                 rows.append(np.concatenate([base_params, [off[p.name] for p in t.parameters]]))
             meta.append((shape, amount, ref))
-        sim = simulate(layout, np.array(rows), problem.base_acc, problem.dt,
+        sim = simulate(layout, np.array(rows), problem.input, problem.dt,
+                       force_input=problem.input_type.force_input,
                        oversample=problem.oversample)
+        output = problem.output_type.simulated(sim)  # the recording's output kind
         i = 0
         for shape, amount, ref in meta:
-            reference = state.rel_acc if ref is None else sim.rel_acc[ref]  # through the chain
+            reference = state.output if ref is None else output[ref]  # through the chain
             ok = sim.ok[i] and (ref is None or sim.ok[ref])
             if ok and amount != 0:
-                on_acc = problem.chain(sim.rel_acc[i])
+                on_acc = problem.chain(output[i])
                 ref_acc = reference if ref is None else problem.chain(reference)
                 g = (on_acc - ref_acc) / amount
                 out.append(Signature(name, probe.strength, float(amount), probe.signed,

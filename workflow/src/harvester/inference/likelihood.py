@@ -22,7 +22,7 @@ import numpy as np
 from scipy.signal import sosfiltfilt
 from scipy.special import logsumexp
 
-from harvester.data.recording import INPUT_KINDS, OUTPUT_KINDS
+from harvester.data.recording import OUTPUT_KINDS
 from harvester.data.signals import butterworth_sos
 from harvester.model.simulate import (Acquisition, Simulation, acquired, residual_sums,
                                       simulate)
@@ -119,9 +119,13 @@ class Problem:
         self._template = np.array([self.known.get(n, np.nan) for n in layout.parameter_names])
 
     def _check_kinds(self) -> None:
-        if self.input_kind not in INPUT_KINDS:
-            raise ValueError(f"input_kind must be one of {list(INPUT_KINDS)}, "
-                             f"got {self.input_kind!r}")
+        from harvester.data.kinds import INPUTS
+        driven = [k for k, kind in INPUTS.items() if kind.model == k]
+        if self.input_kind not in driven:
+            hint = (f" (convert it first: harvester.data.kinds.model_recording gives "
+                    f"{INPUTS[self.input_kind].model})" if self.input_kind in INPUTS else "")
+            raise ValueError(f"input_kind must be one of {driven}, got {self.input_kind!r}"
+                             + hint)
         if self.output_kind not in OUTPUT_KINDS:
             raise ValueError(f"output_kind must be one of {list(OUTPUT_KINDS)}, "
                              f"got {self.output_kind!r}")
@@ -189,9 +193,21 @@ class Problem:
                         force_input=self.input_kind == "force", v_bound=self.v_bound,
                         oversample=self.oversample)
 
+    @property
+    def output_type(self):
+        """The output's kind object (``harvester.data.kinds.OutputKind``)."""
+        from harvester.data.kinds import output_kind
+        return output_kind(self.output_kind)
+
+    @property
+    def input_type(self):
+        """The input's kind object (``harvester.data.kinds.InputKind``)."""
+        from harvester.data.kinds import input_kind
+        return input_kind(self.input_kind)
+
     def output_of(self, sim: Simulation) -> np.ndarray:
         """The simulated output of this problem's kind (particles, samples), NaN where failed."""
-        out = (sim.rel_acc if self.output_kind == "rel_acc" else sim.rel_disp).copy()
+        out = self.output_type.simulated(sim).copy()
         out[~sim.ok] = np.nan
         if self.output_filter is not None and sim.ok.any():
             cutoff, order = self.output_filter

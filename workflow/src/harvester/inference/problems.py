@@ -8,6 +8,7 @@ from collections.abc import Mapping
 
 import pandas as pd
 
+from harvester.data.kinds import model_recording
 from harvester.data.recording import input_output
 from harvester.inference.likelihood import DAQ_OVERSAMPLE, Problem
 from harvester.model.structures import ModelStructure, structure
@@ -50,7 +51,8 @@ def make_problem(recording: pd.DataFrame, model: str | ModelStructure, known: Ma
     """The identification problem for a recording (columns time, an input, an output).
 
     The recording's columns declare the kinds (``harvester.data.recording``): input ``base_acc``
-    or ``force``, output ``rel_acc`` or ``rel_disp``. Base parameters (M, m, k, c_m) missing
+    or ``force`` (a ``base_disp`` is differentiated into ``base_acc`` first,
+    ``harvester.data.kinds.model_recording``), output ``rel_acc`` or ``rel_disp``. Base parameters (M, m, k, c_m) missing
     from ``known`` are identified (:func:`free_base_parameters`); their priors come from
     ``harvester.initial.frf.initial_priors``. For a force input a missing m is set to 0
     (it does not enter eq. 1). ``stride``: the likelihood uses every stride-th sample.
@@ -59,6 +61,7 @@ def make_problem(recording: pd.DataFrame, model: str | ModelStructure, known: Ma
     acquisition does (:data:`harvester.inference.likelihood.DAQ_OVERSAMPLE`; 1: point samples).
     """
     s = structure(model) if isinstance(model, str) else model
+    recording, _ = model_recording(recording, output_filter[0] if output_filter else None)
     kinds, u, y, dt = input_output(recording)
     free = free_base_parameters(s, known, kinds.input_kind)
     check_identifiable(free, kinds.input_kind)

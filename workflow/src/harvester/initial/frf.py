@@ -35,6 +35,7 @@ its modelling error.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -46,6 +47,8 @@ from scipy import optimize, signal
 from harvester.data.errors import DataError
 from harvester.data.recording import RecordingKinds, check_scale, input_output
 from harvester.inference.priors import PriorSpec
+
+log = logging.getLogger("harvester.initial")
 
 #: Default relative prior sd of each base parameter (fraction of the fitted value).
 REL_SD: dict[str, float] = {"M": 0.25, "m": 0.25, "k": 0.5, "c_m": 0.5}
@@ -122,6 +125,7 @@ class FrfFit:
     h_measured: NDArray = field(repr=False)
     h_model: NDArray = field(repr=False)
     coherence: NDArray = field(repr=False)
+    notes: list[str] = field(default_factory=list)  # warnings with their evidence
 
     def summary(self) -> dict:
         """Scalars for JSON."""
@@ -181,11 +185,15 @@ def _refine_log_frf(fb: NDArray, hb: NDArray, weight: NDArray, kinds: RecordingK
 
 
 def _scale_base_ratios(ratios: dict[str, float], known: Mapping[str, float],
-                       kinds: RecordingKinds, source: str, check_units: bool
+                       kinds: RecordingKinds, source: str, check_units: bool,
+                       linearity=None, notes: list[str] | None = None
                        ) -> tuple[dict[str, float], tuple[str, ...]]:
     """(values, fitted) of a base input's fit, whose M, k, c_m are ratios to m: scaled by the
-    first known of M, m, k, c_m; with ``check_units``, an m/M above 1.2 is an error and one
-    off the known m/M by a factor g is reported."""
+    first known of M, m, k, c_m; with ``check_units``, an m/M above 1.2 (or none at all: no
+    mass line) is an error and one off the known m/M by a factor g is reported, unless the
+    recording is visibly nonlinear (``linearity``, a zero-argument function giving
+    ``checks.Nonlinearity``): a linear fit to a friction-dominated device means nothing, so
+    what it gives is a warning (appended to ``notes``) with that evidence."""
     anchor = next((p for p in ("M", "m", "k", "c_m") if p in known and ratios[p] > 0), None)
     if anchor is None:
         raise ValueError(f"{source}: with a base_acc input the FRF gives only ratios to m: "
@@ -194,11 +202,25 @@ def _scale_base_ratios(ratios: dict[str, float], known: Mapping[str, float],
     values = {p: v * s for p, v in ratios.items()}
     fitted = tuple(p for p in ("M", "m", "k", "c_m") if p != anchor)
     if check_units:
-        m_over_M = 1.0 / ratios["M"]
-        if m_over_M > 1.2:
-            raise DataError(source, f"the FRF gives m/M = {m_over_M:.3g} > 1, impossible "
-                            "(M = m + J (2 pi / l)^2): are base_acc and rel_acc in the same "
-                            "unit (m/s^2)? A column in g is 9.81 times too small")
+        m_over_M = 1.0 / ratios["M"] if ratios["M"] > 0 else float("inf")
+        if not m_over_M <= 1.2:
+            found = (f"the linear FRF fit gives m/M = {m_over_M:.3g}" if np.isfinite(m_over_M)
+                     else "the linear FRF fit finds no mass line (M/m = 0)")
+            nl = linearity() if linearity is not None else None
+            if nl is not None and nl.visible:
+                note = (f"{source}: {found}, which no linear device gives (M = m + J (2 pi / "
+                        f"l)^2 >= m); but the recording is visibly nonlinear ({nl.evidence()}),"
+                        " so its FRF does not measure m/M: no unit is inferred from it, and "
+                        "the linear fit's values are only a start")
+                log.warning("%s", note)
+                (notes if notes is not None else []).append(note)
+                return values, fitted
+            raise DataError(source, f"{found} > 1, impossible for a device (M = m + J (2 pi / "
+                            f"l)^2 >= m) whose response looks linear"
+                            + (f" ({nl.evidence()})" if nl is not None else "")
+                            + f": are {kinds.input_kind} and {kinds.output_kind} in the units "
+                            f"of the format ({kinds.input_unit}, {kinds.output_unit})? A column "
+                            "in g is 9.81 times too small, one in mm 1000 times too large")
         if "M" in known and "m" in known:
             check_scale({"m_over_M": m_over_M}, {"m_over_M": known["m"] / known["M"]}, kinds,
                         source)
@@ -226,21 +248,37 @@ def fit_linear_frf(recording: pd.DataFrame, known: Mapping[str, float],
     hold_k = known.get("k") if kinds.input_kind == "force" else None
     hold_c = known.get("c_m") if kinds.input_kind == "force" else None
     k, M, c, resid = _refine_log_frf(fb, hb, weight, kinds, hold_k, hold_c)
+    notes: list[str] = []
+
+    def linearity():
+        from dataclasses import replace
+
+        from harvester.data.checks import nonlinearity
+        return replace(nonlinearity(u, y, 1.0 / dt, band_hz[1]), frf_misfit=resid)
 
     if kinds.input_kind == "base_acc":
         values, fitted = _scale_base_ratios({"M": M, "m": 1.0, "k": k, "c_m": c}, known, kinds,
-                                            source, check_units)
+                                            source, check_units, linearity, notes)
     else:
         values = {"M": M, "m": np.nan, "k": k, "c_m": c}
         fitted = ("M",) + (("k",) if hold_k is None else ()) + (("c_m",) if hold_c is None else ())
         if check_units:
-            check_scale({"M": M, "k": k, "c_m": c}, {p: known[p] for p in ("M",) if p in known},
-                        kinds, source)
+            try:
+                check_scale({"M": M, "k": k, "c_m": c},
+                            {p: known[p] for p in ("M",) if p in known}, kinds, source)
+            except DataError as err:
+                nl = linearity()
+                if not nl.visible:
+                    raise
+                notes.append(f"{err}; but the recording is visibly nonlinear "
+                             f"({nl.evidence()}), so its FRF does not measure M: no unit is "
+                             "inferred from it")
+                log.warning("%s", notes[-1])
     h_model = linear_frf(f, values["M"], values["m"] if kinds.input_kind == "base_acc" else 1.0,
                          values["k"], values["c_m"], kinds)
     return FrfFit(values={p: float(v) for p, v in values.items()}, fitted=fitted,
                   residual=resid, kinds=kinds, band_hz=(float(band_hz[0]), float(band_hz[1])),
-                  freqs_hz=f, h_measured=h, h_model=h_model, coherence=coh)
+                  freqs_hz=f, h_measured=h, h_model=h_model, coherence=coh, notes=notes)
 
 
 def frf_prior_specs(fit: FrfFit, free: tuple[str, ...],

@@ -31,10 +31,13 @@ def beta_prior(sigma_v: float) -> PriorSpec:
 
 def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
                      given: Mapping[str, Mapping[str, float]] | None = None,
-                     source: str = "<recording>") -> dict[str, PriorSpec]:
+                     source: str = "<recording>", lowpass_hz: float | None = None
+                     ) -> dict[str, PriorSpec]:
     """Priors for one recording of a device whose M, m, k are ``known``: c_m (and F_c) from the
     recording's FRF (:func:`fit_viscous_damping`) as in the initial modelling, beta from its
-    RMS velocity, then the priors ``given`` (name -> entry as in config ``priors``: mean
+    RMS velocity (any kind of recording: read as the paper's base_acc -> rel_acc case by
+    ``harvester.data.kinds.paper_case``, band-limited at ``lowpass_hz``; a force input's m
+    is then 1 kg), then the priors ``given`` (name -> entry as in config ``priors``: mean
     or from: table1, sd, optional lower; e.g. a sidecar's). sigma's prior is left to the
     diagnosis (scaled to the recording's residual, ``diagnosis.run.default_priors``) unless
     given: Table 4's is the paper's rig's noise.
@@ -61,7 +64,10 @@ def recording_priors(df: pd.DataFrame, known: Mapping[str, float],
     specs = {n: PriorSpec(n, m_, s_, unit[n]) for n, (m_, s_) in TABLE4.items() if n in unit}
     stated = _stated_priors(given or {}, specs)
     try:
-        _set_damping_priors(specs, df, known, stated.get("F_c"), unit, source)
+        from harvester.data.kinds import paper_case
+        balance = dissipation(df, known, lowpass_hz, source)
+        df, known = paper_case(df, known, lowpass_hz, source)
+        _set_damping_priors(specs, df, known, stated.get("F_c"), unit, source, balance)
     except (DataError, ValueError, np.linalg.LinAlgError) as err:
         log.warning("FRF damping fit failed (%s); c_m, F_c and beta priors are Table 4's", err)
     return {**specs, **stated}
@@ -86,12 +92,42 @@ def _stated_priors(given: Mapping[str, Mapping[str, float]],
     return stated
 
 
+#: The power balance's damping force replaces the FRF fit's bound on c_m and F_c when it is
+#: this many times larger (the linear FRF fit of a friction-dominated device can find no
+#: damping at all: 0 N s/m on the frame of Marino and Cicirello).
+BALANCE_FACTOR = 2.0
+
+
+def dissipation(df: pd.DataFrame, known: Mapping[str, float], lowpass_hz: float | None,
+                source: str = "<recording>", lead_in_s: float = 1.0
+                ) -> tuple[float, float] | None:
+    """(damping force c_eq sigma_v in N, RMS relative velocity sigma_v in m/s) the recording
+    shows by the power balance of eq. (1), <F_d z'> = -g <u z'> (the input kind's
+    ``dissipative_force``, ``harvester.data.kinds``), with the measured z' (the output
+    kind's ``velocity``), after ``lead_in_s``; None where it cannot tell (no drive gain,
+    no motion)."""
+    from harvester.data.kinds import input_kind, model_recording, output_kind
+    from harvester.data.recording import recording_kinds
+    from harvester.data.signals import uniform_step
+    df, _ = model_recording(df, lowpass_hz, source)
+    kinds = recording_kinds(df, source)
+    inp, out = input_kind(kinds.input_kind), output_kind(kinds.output_kind)
+    dt = uniform_step(df["time"].to_numpy(dtype=float), source)
+    v = out.velocity(df[out.name].to_numpy(dtype=float), dt, lowpass_hz)
+    cut = slice(int(round(lead_in_s / dt)), len(df) - int(round(0.5 / dt)))
+    force = inp.dissipative_force(df[inp.name].to_numpy(dtype=float)[cut], v[cut], known)
+    return None if force is None else (force, float(np.std(v[cut])))
+
+
 def _set_damping_priors(specs: dict[str, PriorSpec], df: pd.DataFrame,
                         known: Mapping[str, float], measured_friction: PriorSpec | None,
-                        unit: Mapping[str, str], source: str) -> None:
+                        unit: Mapping[str, str], source: str,
+                        balance: tuple[float, float] | None = None) -> None:
     """Set ``specs``' c_m (and, without a ``measured_friction``, F_c) from the recording's
-    FRF and beta from its RMS velocity (m/s), as :func:`recording_priors` describes. Raises
-    what the FRF fit raises; priors set before the failure stay set."""
+    FRF and beta from its RMS velocity (m/s), as :func:`recording_priors` describes; where
+    the power balance's damping force (``balance``, :func:`dissipation`) is BALANCE_FACTOR
+    times the FRF fit's, its bounds are the balance's. Raises what the FRF fit raises;
+    priors set before the failure stay set."""
     lead_in = min(256, len(df) // 4)
 
     def fit(friction: float) -> DampingFit:
@@ -113,6 +149,14 @@ def _set_damping_priors(specs: dict[str, PriorSpec], df: pd.DataFrame,
         log.info("initial modelling: the recording's FRF gives c_m = %.1f N s/m without "
                  "friction (RMS velocity %.3g m/s); no measured friction, so c_m lies in "
                  "0-%.1f N s/m and F_c in 0-%.2f N", c_v, viscous.sigma_v, c_v, f_max)
+        if balance is not None and balance[0] > BALANCE_FACTOR * c_v * viscous.sigma_v:
+            force, sigma_v = balance
+            c_v, f_max = force / sigma_v, float(np.sqrt(np.pi / 2.0) * force)
+            log.warning("initial modelling: the power the drive puts in says the motion is "
+                        "damped by %.3g N (RMS velocity %.3g m/s measured), more than %g "
+                        "times what the linear FRF fit shows (a friction-dominated device): "
+                        "c_m lies in 0-%.3g N s/m and F_c in 0-%.3g N", force, sigma_v,
+                        BALANCE_FACTOR, c_v, f_max)
         specs["c_m"] = PriorSpec("c_m", 0.0, c_v, unit["c_m"])
         specs["F_c"] = PriorSpec("F_c", 0.0, float(f_max), unit["F_c"])
     if sigma_v > 0.0:
@@ -148,6 +192,8 @@ def identification_priors(df: pd.DataFrame, free: tuple[str, ...],
     from harvester.initial.frf import initial_priors, sigma_prior
     from harvester.study.paper import TABLE1
 
+    from harvester.data.kinds import model_recording
+    df, _ = model_recording(df, lowpass_hz, source)  # a base_disp: its base_acc
     kinds = recording_kinds(df, source)
     specs: dict[str, PriorSpec] = {}
     notes: list[str] = []
@@ -162,6 +208,7 @@ def identification_priors(df: pd.DataFrame, free: tuple[str, ...],
         top = FRF_BAND_TOP * (lowpass_hz or 0.5 * sampling_rate(df, source))
         fit, frf = initial_priors(df, known, base, (FRF_BAND_LOW_HZ, top), source=source)
         specs.update({p: frf[p] for p in base})
+        notes += fit.notes
         notes.append(f"priors of {', '.join(base)}: a linear FRF fit over "
                      f"{FRF_BAND_LOW_HZ:g}-{top:.3g} Hz (" + ", ".join(
                          f"{p} = {fit.values[p]:.4g}" for p in base) + ")")

@@ -1,0 +1,156 @@
+"""Every kind of recording through the diagnosis (issue 41): the kind objects of
+``harvester.data.kinds``, a base displacement differentiated for the model, the checks that
+rest on linear theory on a visibly nonlinear recording, and the public recordings' readers.
+
+Fast: the diagnosis runs as ``quick_detect`` (MAP and Laplace, seconds); the real frame
+recordings are read from ../shared/data when they are there (skipped otherwise).
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from harvester.data import checks
+from harvester.data.errors import DataError
+from harvester.data.kinds import (INPUTS, OUTPUTS, derivative, drift, input_kind,
+                                  model_recording, output_kind, paper_case)
+from harvester.data.recording import RecordingKinds
+from harvester.diagnosis import DiagnosisSettings
+from harvester.diagnosis.run import quick_detect
+from harvester.synthetic.measured import TABLE1_KNOWN
+
+from test_input_checks import displacement_recording
+
+FS = 250.0
+SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
+FRAME = SHARED / "marino-frame"
+SILVERBOX = SHARED / "silverbox" / "Schroeder80mV.mat"
+
+
+def _sines(n: int = 2500):
+    t = np.arange(n) / FS
+    w = 2 * np.pi * np.array([1.1, 4.7])[:, None]
+    amp = np.array([2e-3, 5e-4])[:, None]
+    y = np.sum(amp * np.sin(w * t + 0.3), axis=0)
+    return t, y, np.sum(amp * w * np.cos(w * t + 0.3), axis=0), \
+        -np.sum(amp * w**2 * np.sin(w * t + 0.3), axis=0)
+
+
+def test_derivatives_of_a_displacement_are_exact_in_the_band() -> None:
+    t, y, v, a = _sines()
+    y = y + 1e-4 * t  # a straight drift has no acceleration
+    inner = slice(250, -250)
+    acc = derivative(y, 1 / FS, 2, 20.0)
+    vel = derivative(y, 1 / FS, 1, 20.0)
+    assert np.max(np.abs(acc - a)[inner]) < 1e-8 * np.std(a)
+    assert np.max(np.abs(vel - v - 1e-4)[inner]) < 1e-8 * np.std(v)
+    # the edges (inside the lead-in and the last 0.5 s the diagnosis leaves out): within
+    # 1e-3 from 0.25 s of them (the end points themselves: half the RMS)
+    assert np.max(np.abs(acc - a)[62:-62]) < 1e-3 * np.std(a)
+
+
+def test_one_object_per_kind() -> None:
+    assert set(INPUTS) == {"base_acc", "force", "base_disp"}
+    assert set(OUTPUTS) == {"rel_acc", "rel_disp"}
+    assert input_kind("base_disp").model == "base_acc"
+    assert input_kind("force").force_input and not input_kind("base_acc").force_input
+    assert input_kind("base_acc").drive_gain({"m": 8.0}) == 8.0
+    assert input_kind("force").drive_gain({}) == -1.0
+
+    class Sim:
+        rel_acc, rel_disp = np.ones(3), np.zeros(3)
+    assert output_kind("rel_acc").simulated(Sim) is Sim.rel_acc
+    assert output_kind("rel_disp").simulated(Sim) is Sim.rel_disp
+    with pytest.raises(KeyError, match="known: base_acc, force, base_disp"):
+        input_kind("base_vel")
+
+
+def test_the_power_balance_does_not_depend_on_the_input_kind() -> None:
+    """A force F = -m y'' drives eq. (1) as the base acceleration y'' does: the same
+    dissipated force from either."""
+    rng = np.random.default_rng(0)
+    u, v = rng.standard_normal(500), rng.standard_normal(500)
+    v = v - 0.3 * u
+    base = input_kind("base_acc").dissipative_force(u, v, {"m": 8.0})
+    force = input_kind("force").dissipative_force(-8.0 * u, v, {})
+    assert base == pytest.approx(force) and base > 0
+
+
+def test_a_base_displacement_becomes_the_model_input_and_the_raw_stays() -> None:
+    t, y, _, a = _sines()
+    raw = pd.DataFrame({"time": t, "base_disp": y, "rel_disp": 0.1 * y})
+    kept = raw.copy()
+    out, notes = model_recording(raw, 20.0, "rec.csv")
+    assert list(out.columns) == ["time", "base_acc", "rel_disp"]
+    assert np.max(np.abs(out.base_acc - a)[250:-250]) < 1e-8 * np.std(a)
+    assert "second derivative of base_disp" in notes[0] and "20 Hz" in notes[0]
+    pd.testing.assert_frame_equal(raw, kept)  # raw data never modified
+    same, none = model_recording(out, 20.0)
+    assert same is out and none == []
+    pc, known = paper_case(raw.rename(columns={"base_disp": "force"}), {"M": 3.0}, 20.0)
+    assert known["m"] == 1.0 and np.allclose(pc.base_acc, -y)
+
+
+def test_a_drifting_base_sensor_is_a_warning_with_its_evidence() -> None:
+    t, y, _, _ = _sines()
+    d = drift(y + 5e-3 * t / t[-1], 1 / FS)
+    assert d.drifting and d.drift == pytest.approx(5e-3, rel=0.2)
+    df = pd.DataFrame({"time": t, "base_disp": y + 5e-3 * t / t[-1], "rel_disp": 0.1 * y})
+    found = checks.drifting_base(df, RecordingKinds("base_disp", "rel_disp"), 1 / FS, "r.csv")
+    assert len(found) == 1 and "drifts by" in found[0].message
+    assert not checks.drifting_base(df.assign(base_disp=y), RecordingKinds("base_disp",
+                                                                           "rel_disp"),
+                                    1 / FS, "r.csv")
+
+
+def test_the_diagnosis_names_friction_from_displacements() -> None:
+    """base_disp -> rel_disp of the tanh device: a linear baseline misses friction, the tanh
+    baseline misses nothing (quick_detect)."""
+    rec = displacement_recording()
+    settings = DiagnosisSettings.fast(lowpass_hz=None)
+    det, state = quick_detect(rec, "linear", dict(TABLE1_KNOWN), settings=settings)
+    assert (state.problem.input_kind, state.problem.output_kind) == ("base_acc", "rel_disp")
+    best = max(det.candidates, key=lambda c: c.statistic)
+    assert det.p_value < 1e-3 and best.effect == "tanh_friction"
+    det, _ = quick_detect(rec, "tanh", dict(TABLE1_KNOWN), settings=settings)
+    assert det.p_value > 0.05
+
+
+@pytest.mark.skipif(not FRAME.is_dir(), reason="no ../shared/data/marino-frame")
+def test_the_frame_recordings_read_and_their_linear_frf_is_a_warning() -> None:
+    from harvester.data.public import marino_frame
+    from harvester.initial.frf import fit_linear_frf
+    for load in (250, 450):
+        rec = marino_frame(FRAME, load)
+        assert list(rec.data.columns) == ["time", "base_disp", "rel_disp"]
+        assert rec.sidecar == {"M": 3.0799, "m": 3.0799, "k": 1191.0, "filtered_at_hz": 20.0}
+        assert 5e-4 < rec.data.rel_disp.std() < 1e-3  # m, not mm
+        df, _ = model_recording(rec.data, 20.0)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # no numpy division warnings
+            fit = fit_linear_frf(df, {"m": 3.0799}, (0.3, 16.0), source=f"{load} g")
+        assert "visibly nonlinear" in fit.notes[0] and "nepers RMS" in fit.notes[0]
+        assert "m/M = " in fit.notes[0]
+
+
+def test_a_linear_recording_with_an_impossible_mass_ratio_is_still_an_error() -> None:
+    from test_recording_kinds import TRUTH, synthetic
+    from harvester.initial.frf import fit_linear_frf
+    df = synthetic("base_acc", "rel_disp", n=1600, noise=0.0)
+    with pytest.raises(DataError, match="m/M = .* > 1, impossible .* looks linear"):
+        fit_linear_frf(df.assign(base_acc=df["base_acc"] / 9.80665), {"m": TRUTH["m"]},
+                       (2.0, 40.0))
+
+
+@pytest.mark.skipif(not SILVERBOX.is_file(), reason="no ../shared/data/silverbox")
+def test_the_silverbox_reads_in_volts() -> None:
+    from harvester.data.public import silverbox
+    rec = silverbox(SILVERBOX, samples=4096)
+    assert list(rec.data.columns) == ["time", "force", "rel_disp"] and len(rec.data) == 4096
+    assert rec.sidecar == {} and "VOLTS" in rec.notes[0]
+    assert 1.0 / np.mean(np.diff(rec.data.time)) == pytest.approx(610.35, abs=0.01)

@@ -1,0 +1,124 @@
+"""Readers of public recordings of real devices into the recording format.
+
+Each reader takes the files as published (read only; nothing is downloaded) and returns a
+recording (``harvester.data.recording``: time, one input, one output, SI units) and the
+sidecar (``harvester.data.sidecar``) its source gives, with what was done said in ``notes``.
+
+* :func:`marino_frame`: the base-excited single-storey frame with a brass-on-steel friction
+  contact of Marino and Cicirello (2023): laser displacements of the storey x and of the base
+  y in mm at 250 Hz -> ``base_disp`` = y and ``rel_disp`` = x - y in m, both low-passed
+  (zero phase) at :data:`FRAME_LOWPASS_HZ` (above 10 Hz the channels hold sensor noise only,
+  and the base displacement is differentiated twice for the model), each about its mean (the
+  lasers' zero is arbitrary); sidecar M = m = 3.0799 kg, k = 1191 N/m (their initial
+  estimates, from tests without the contact), filtered_at_hz.
+* :func:`silverbox`: the Silverbox electronic Duffing oscillator (Wigren and Schoukens 2013):
+  input V1 (a force, in volts) -> ``force``, output V2 (a displacement, in volts) ->
+  ``rel_disp``, each about its mean (their offsets are measurement errors); M, m, k unknown,
+  so no sidecar values: the values are volts, not N and m.
+
+The shared data directory's SOURCE.md files give the provenance.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from harvester.data.errors import DataError
+from harvester.data.signals import lowpass
+
+#: The frame's device (Marino and Cicirello 2023, initial estimates): M z'' + C z' + K z
+#: + F_f = -M y'' with z = x - y, so m = M.
+FRAME_DEVICE = {"M": 3.0799, "m": 3.0799, "k": 1191.0}
+#: Zero-phase low-pass (Hz, order 8) of both frame channels.
+FRAME_LOWPASS_HZ = 20.0
+FRAME_FILTER_ORDER = 8
+#: Silverbox sampling rate (Hz): 1e7 / 2^14.
+SILVERBOX_FS = 1e7 / 2**14
+#: First sample of its periodic multisine (SOURCE.md).
+SILVERBOX_START = 10585
+
+
+@dataclass
+class PublicRecording:
+    """A recording read from public files: the table, the sidecar's content (as a
+    ``RECORDING.yaml`` would hold it) and what was done."""
+
+    data: pd.DataFrame
+    sidecar: dict
+    notes: list[str] = field(default_factory=list)
+
+    def write(self, csv_path: str | Path) -> Path:
+        """The recording as ``csv_path`` and its sidecar beside it (``.yaml``)."""
+        import yaml
+
+        from harvester.data.daq import write_recording
+        from harvester.data.sidecar import sidecar_path
+        csv_path = Path(csv_path)
+        csv_path.parent.mkdir(parents=True, exist_ok=True)
+        write_recording(self.data, csv_path)
+        if self.sidecar:
+            sidecar_path(csv_path).write_text(yaml.safe_dump(self.sidecar, sort_keys=False))
+        return csv_path
+
+
+def _mat(path: Path, names: tuple[str, ...]) -> dict[str, np.ndarray]:
+    """Variables of a MATLAB file as flat float arrays (DataError naming the file and what
+    is missing)."""
+    from scipy.io import loadmat
+    if not path.is_file():
+        raise DataError(path, "file not found")
+    try:
+        data = loadmat(str(path))
+    except (OSError, ValueError, NotImplementedError) as err:
+        raise DataError(path, f"cannot read as a MATLAB file: {err}") from None
+    missing = [n for n in names if n not in data]
+    if missing:
+        found = sorted(k for k in data if not k.startswith("__"))
+        raise DataError(path, f"no variable {', '.join(missing)} (found {', '.join(found)})")
+    return {n: np.asarray(data[n], dtype=float).ravel() for n in names}
+
+
+def marino_frame(directory: str | Path, load_g: int) -> PublicRecording:
+    """The frame's recording at the normal load ``load_g`` (g: 250 or 450 shipped) from
+    ``directory``/s_b_{load}g_x.mat and _y.mat (module docstring)."""
+    directory = Path(directory)
+    xf, yf = (directory / f"s_b_{load_g}g_{c}.mat" for c in ("x", "y"))
+    x, y = _mat(xf, ("t", "x")), _mat(yf, ("t", "y"))
+    if x["t"].shape != y["t"].shape or not np.allclose(x["t"], y["t"], atol=1e-9):
+        raise DataError(yf, f"its time t differs from {xf.name}'s: the channels are not one "
+                        "record")
+    t = x["t"] - x["t"][0]
+    fs = 1.0 / float(np.mean(np.diff(t)))
+    base = y["y"] / 1000.0
+    rel = (x["x"] - y["y"]) / 1000.0
+    base, rel = (lowpass(c, fs, FRAME_LOWPASS_HZ, FRAME_FILTER_ORDER) for c in (base, rel))
+    data = pd.DataFrame({"time": t, "base_disp": base - base.mean(),
+                         "rel_disp": rel - rel.mean()})
+    notes = [f"{xf.name}, {yf.name}: x, y (mm) -> base_disp = y, rel_disp = x - y (m), each "
+             f"low-passed at {FRAME_LOWPASS_HZ:g} Hz (order {FRAME_FILTER_ORDER}, zero phase) "
+             f"and taken about its mean; time from 0 (the file's starts at {x['t'][0]:g} s)"]
+    sidecar = {**FRAME_DEVICE, "filtered_at_hz": FRAME_LOWPASS_HZ}
+    return PublicRecording(data, sidecar, notes)
+
+
+def silverbox(path: str | Path, start: int = SILVERBOX_START,
+              samples: int | None = None) -> PublicRecording:
+    """The Silverbox record ``path`` (Schroeder80mV.mat) from sample ``start`` (``samples``
+    of it, None: to the end) as force -> rel_disp in volts (module docstring)."""
+    path = Path(path)
+    v = _mat(path, ("V1", "V2"))
+    stop = v["V1"].size if samples is None else start + int(samples)
+    if not 0 <= start < stop <= v["V1"].size:
+        raise DataError(path, f"samples {start}-{stop} outside its {v['V1'].size} samples")
+    u, y = (v[c] - np.mean(v[c]) for c in ("V1", "V2"))
+    n = stop - start
+    data = pd.DataFrame({"time": np.arange(n) / SILVERBOX_FS, "force": u[start:stop],
+                         "rel_disp": y[start:stop]})
+    notes = [f"{path.name}: V1 -> force, V2 -> rel_disp, in VOLTS (the circuit's M, m, k are "
+             f"not known in SI), each about its mean over the file; samples {start}-{stop} at "
+             f"{SILVERBOX_FS:.6g} Hz"]
+    return PublicRecording(data, {}, notes)
