@@ -154,3 +154,17 @@ def test_views_and_the_named_effect_beside_the_latent_force():
     wrong = effect_force(lf, structure("linear+cubic_stiffness"), np.array([60.0, 1e6]),
                          state.problem.known, "cubic_stiffness")
     assert wrong.share < 0.2
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(4))
+def test_coverage_over_seeds_on_40_s_records(seed):
+    """40 s records of linear + Coulomb (6 N, the library's simulator), linear baseline at the
+    truth, default settings: +-2 sd holds the band-limited truth at 0.96-1.0 of the samples
+    (conservative), the error a fifth of the force or less."""
+    values = {**TABLE1_KNOWN, "c_m": 60.0, "F_coulomb": 6.0}
+    df, sim = _library_record(("coulomb_friction",), values, seconds=41.5, seed=10 + seed)
+    state = _state(df, "linear", [60.0])
+    lf = latent_force(state)
+    w = slice(*state.problem.window)
+    _check(lf, state.problem.chain(6.0 * np.tanh(sim.rel_vel[0] / 1e-3))[w], (0.93, 1.0), 0.22)

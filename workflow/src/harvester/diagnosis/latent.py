@@ -41,7 +41,8 @@ from scipy import optimize
 from harvester.data.signals import lowpass
 from harvester.diagnosis.baseline import BaselineState
 from harvester.diagnosis.state_space import (MATERN_STATES, backward_sample, discretise,
-                                             kalman_filter, matern, rts_smoother)
+                                             kalman_filter, kalman_loglik, matern,
+                                             rts_smoother)
 from harvester.diagnosis.term_forces import term_forces
 
 log = logging.getLogger("harvester.diagnosis")
@@ -132,6 +133,7 @@ class _Device:
     kind: str
     z_scale: float
     v_scale: float
+    stride: int
 
     @property
     def M(self) -> float:
@@ -164,7 +166,7 @@ def _device(state: BaselineState, stop: int, stride: int) -> tuple[_Device, np.n
     out = sim.rel_disp[0] if p.output_kind == "rel_disp" else sim.rel_acc[0]
     scale = lambda x: float(max(np.sqrt(np.mean(np.square(x[:stop]))), 1e-9))  # noqa: E731
     dev = _Device(values, p.dt, drive, np.zeros(stop) if force_input else u, u, y, measured,
-                  p.output_kind, scale(sim.rel_disp[0]), scale(sim.rel_vel[0]))
+                  p.output_kind, scale(sim.rel_disp[0]), scale(sim.rel_vel[0]), stride)
     return dev, y - p.chain(out)[:stop]
 
 
@@ -215,7 +217,9 @@ def fit_hyperparameters(dev: _Device, kernel: str, amp0: float, noise_max: float
     def cost(x):
         length, amp, noise = np.exp(x) if fit_noise else (*np.exp(x), noise_max)
         try:
-            value = -_filter(dev, kernel, length, amp, noise)[0][4]
+            disc, H, D, R, m0, P0, _ = _model(dev, kernel, length, amp, noise)
+            value = -kalman_loglik(disc.Phi, disc.G0, disc.G1, disc.Q, H, D, R, dev.drive,
+                                   dev.y, dev.stride, m0, P0)
         except (np.linalg.LinAlgError, ValueError):
             return 1e300
         return value if np.isfinite(value) else 1e300
