@@ -273,42 +273,54 @@ def _terms_along(state: BaselineState, dev: _Device, z, v, g) -> np.ndarray:
     return sum(forces.values())
 
 
+def _forces(state: BaselineState, dev: _Device, mean: np.ndarray, paths: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(f's posterior mean, its draws, the baseline's term forces along the mean path), each
+    through the band (N): f = g - sum_T X_T per draw; without terms f's mean is the
+    smoother's own, exact."""
+    band = state.problem.chain
+    z, v, g = paths[..., 0], paths[..., 1], paths[..., 2]
+    f_paths = band(g - _terms_along(state, dev, z, v, g))
+    terms_mean = band(_terms_along(state, dev, mean[:, 0], mean[:, 1], mean[:, 2])[0])
+    if not state.problem.structure.layout.terms:
+        return band(mean[:, 2]), f_paths, terms_mean
+    return f_paths.mean(axis=0), f_paths, terms_mean
+
+
 def latent_force(state: BaselineState, window: tuple[int, int] | None = None, *,
                  kernel: str = "matern52", noise: str | float = "fit",
                  draws: int = PATH_DRAWS, seed: int = 0) -> LatentForce:
     """The missing force of the baseline ``state`` over ``window`` (samples; the problem's
     by default), module docstring. ``kernel``: 'matern32' or 'matern52'; ``noise``: 'fit'
     (marginal likelihood, at most the baseline's sigma), 'baseline' (its sigma) or a value in
-    the output's unit; ``draws``: joint draws of the state path behind the sd."""
+    the output's unit (an independent noise floor); ``draws``: joint draws of the state path
+    behind the sd."""
     if kernel not in MATERN_STATES:
         raise ValueError(f"kernel must be one of {sorted(MATERN_STATES)}, got {kernel!r}")
     clock = time.perf_counter()
     p = state.problem
     start, stop = window or p.window
-    stride = measurement_stride(state)
-    dev, residual = _device(state, stop, stride)
+    dev, residual = _device(state, stop, measurement_stride(state))
     sigma_b = float(state.theta[-1])
     fixed = None if noise == "fit" else (sigma_b if noise == "baseline" else float(noise))
     length, amp, noise_sd, logml = fit_hyperparameters(
         dev, kernel, _force_scale(dev, residual[start:stop]), fixed or sigma_b, fixed is None)
     filtered, disc, T = _filter(dev, kernel, length, amp, noise_sd)
     mean, paths = _paths(dev, disc, T, filtered, draws, seed)
-    z, v, g = paths[..., 0], paths[..., 1], paths[..., 2]
-    f_paths = p.chain(g - _terms_along(state, dev, z, v, g))
-    terms_mean = p.chain(_terms_along(state, dev, mean[:, 0], mean[:, 1], mean[:, 2])[0])
-    force = p.chain(mean[:, 2]) - terms_mean if not p.structure.layout.terms \
-        else f_paths.mean(axis=0)
+    force, f_paths, terms_mean = _forces(state, dev, mean, paths)
     w = slice(start, stop)
-    acc = _acceleration(dev, mean[:, 0], mean[:, 1], mean[:, 2])
+    z, v, g = paths[:, w, 0], paths[:, w, 1], paths[:, w, 2]
+    acc_draws = (dev.drive[w] - dev.values["c_m"] * v - dev.values["k"] * z - g) / dev.M
     out = LatentForce(
-        np.arange(stop)[w] * p.dt, force[w], f_paths.std(axis=0)[w], mean[w, 0],
-        z[:, w].std(axis=0), mean[w, 1],
-        acc[w], dev.input[w], terms_mean[w], p.structure.name, dev.values, p.input_kind,
-        p.output_kind,
-        kernel, length, amp, noise_sd, sigma_b, logml, float(getattr(p, "band_hz", np.nan)),
-        stride, 0.0, int(getattr(p, "filter_order", 8)), f_paths[:, w],
-        np.stack([z[:, w], v[:, w], _acceleration(dev, z, v, g)[:, w]]))
-    out.seconds = time.perf_counter() - clock
+        time=np.arange(stop)[w] * p.dt, force=force[w], sd=f_paths.std(axis=0)[w],
+        rel_disp=mean[w, 0], disp_sd=z.std(axis=0), rel_vel=mean[w, 1],
+        rel_acc=_acceleration(dev, mean[:, 0], mean[:, 1], mean[:, 2])[w],
+        input=dev.input[w], baseline_terms=terms_mean[w], baseline=p.structure.name,
+        values=dev.values, input_kind=p.input_kind, output_kind=p.output_kind, kernel=kernel,
+        length_scale_s=length, amplitude_N=amp, noise_sd=noise_sd, baseline_noise_sd=sigma_b,
+        log_marginal=logml, band_hz=float(getattr(p, "band_hz", np.nan)), stride=dev.stride,
+        seconds=time.perf_counter() - clock, filter_order=int(getattr(p, "filter_order", 8)),
+        draws=f_paths[:, w], state_draws=np.stack([z, v, acc_draws]))
     log.info("latent force of %s: RMS %.3g N (sd %.2g N), length scale %.3g s, noise %.3g "
              "(baseline's sigma %.3g), %.1f s", p.structure.name, out.rms_N, np.mean(out.sd),
              length, noise_sd, sigma_b, out.seconds)
