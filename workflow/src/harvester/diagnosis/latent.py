@@ -134,6 +134,7 @@ class _Device:
     z_scale: float
     v_scale: float
     stride: int
+    initial_sd: float = 0.01  # prior sd of (z, z') at the first sample / their RMS
 
     @property
     def M(self) -> float:
@@ -170,6 +171,11 @@ def _device(state: BaselineState, stop: int, stride: int) -> tuple[_Device, np.n
     return dev, y - p.chain(out)[:stop]
 
 
+#: Prior sd of (z, z') at the record's first sample, in units of their RMS: the model starts
+#: at rest (``Problem``); a record that does not is given a wider one (``initial_sd``).
+INITIAL_SD = 0.01
+
+
 def _model(dev: _Device, kernel: str, length: float, amp: float, noise: float):
     """The augmented model in scaled states (z / z_s, z' / v_s, g^(j) / (amp lam^j)):
     (discrete model, H, D, R, initial mean and covariance, scales)."""
@@ -193,7 +199,7 @@ def _model(dev: _Device, kernel: str, length: float, amp: float, noise: float):
     H = np.zeros(n)
     H[:3] = h3 * T[:3]
     P0 = np.zeros((n, n))
-    P0[:2, :2] = np.diag([1e-4, 1e-4])
+    P0[:2, :2] = np.diag([dev.initial_sd**2] * 2)
     P0[2:, 2:] = P_inf * np.outer(Ti[2:], Ti[2:])
     return disc, H, D, noise**2, np.zeros(n), P0, T
 
@@ -289,18 +295,20 @@ def _forces(state: BaselineState, dev: _Device, mean: np.ndarray, paths: np.ndar
 
 def latent_force(state: BaselineState, window: tuple[int, int] | None = None, *,
                  kernel: str = "matern52", noise: str | float = "fit",
-                 draws: int = PATH_DRAWS, seed: int = 0) -> LatentForce:
+                 draws: int = PATH_DRAWS, seed: int = 0,
+                 initial_sd: float = INITIAL_SD) -> LatentForce:
     """The missing force of the baseline ``state`` over ``window`` (samples; the problem's
     by default), module docstring. ``kernel``: 'matern32' or 'matern52'; ``noise``: 'fit'
     (marginal likelihood, at most the baseline's sigma), 'baseline' (its sigma) or a value in
     the output's unit (an independent noise floor); ``draws``: joint draws of the state path
-    behind the sd."""
+    behind the sd; ``initial_sd``: :data:`INITIAL_SD`."""
     if kernel not in MATERN_STATES:
         raise ValueError(f"kernel must be one of {sorted(MATERN_STATES)}, got {kernel!r}")
     clock = time.perf_counter()
     p = state.problem
     start, stop = window or p.window
     dev, residual = _device(state, stop, measurement_stride(state))
+    dev.initial_sd = float(initial_sd)
     sigma_b = float(state.theta[-1])
     fixed = None if noise == "fit" else (sigma_b if noise == "baseline" else float(noise))
     length, amp, noise_sd, logml = fit_hyperparameters(

@@ -7,6 +7,9 @@ and the best one said in one sentence ("a force periodic in z, period 3.0 mm, am
 5.0 N, explains 70 % of the missing force"). The shapes, each linear in its amplitudes, with
 at most one scanned parameter:
 
+The force's mean (a preload, a sensor's offset) is taken out first and stated apart; the
+shares are of what varies.
+
 ``odd in z``        k_1 z + k_3 z^3 + k_5 z^5 (a stiffness error, a hardening spring)
 ``even in z``       f_0 + k_2 z^2 + k_4 z^4 (an offset, an asymmetric spring)
 ``friction``        F tanh(z' / v_0), v_0 scanned (Coulomb to a smooth sign law)
@@ -19,6 +22,9 @@ at most one scanned parameter:
                     from outside)
 ``loop``            F h(t), h the library's Dahl state (``hysteresis``) at unit force, its
                     pre-sliding displacement delta scanned (a hysteresis loop in (z, f))
+``... on the ground``  friction and loop on the absolute velocity x' = z' + y' (a contact
+                    fixed to the ground: stick holds the mass still, so f = -k z while it
+                    sticks; Marino and Cicirello's frame)
 ``inertial``        dM z'' + dm y'' (a mass error, the diagnosis's catch-all name; it is
                     here so that a named mass error can be checked against the force's shape)
 """
@@ -29,7 +35,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import optimize
+from scipy import optimize, signal
 
 from harvester.diagnosis.latent import LatentForce
 from harvester.diagnosis.term_forces import term_force
@@ -37,6 +43,10 @@ from harvester.model.terms import term
 
 #: Points of each scanned parameter's grid before the refinement.
 SCAN_POINTS = 40
+#: Cut-off (Hz) of the high-pass that keeps the base velocity integrated from y'' from drifting.
+HIGHPASS_HZ = 0.05
+#: Share of the input's power in its strongest line above which it is a harmonic excitation.
+INPUT_LINE_SHARE = 0.5
 #: A shape is preferred to one earlier in the dictionary only if it explains this much more.
 SHARE_MARGIN = 0.02
 
@@ -64,6 +74,7 @@ class ShapeDescription:
     rms_N: float
     mean_sd_N: float
     sentence: str
+    offset_N: float = 0.0  # the force's mean, taken out before the shapes
 
     @property
     def best(self) -> Shape:
@@ -74,6 +85,7 @@ class ShapeDescription:
 
     def to_dict(self) -> dict:
         return {"sentence": self.sentence, "rms_N": self.rms_N, "mean_sd_N": self.mean_sd_N,
+                "offset_N": self.offset_N,
                 "shapes": [s.to_dict() for s in self.shapes]}
 
 
@@ -146,14 +158,36 @@ def even_in_z(lf: LatentForce, f: np.ndarray) -> Shape:
                                       "k4_N_per_m4": k[2]}, sentence, fitted)
 
 
-def friction(lf: LatentForce, f: np.ndarray) -> Shape:
-    """F tanh(z' / v_0) (N), v_0 (m/s) scanned from 1e-3 to 1 x the RMS velocity."""
-    sv = _rms(lf.rel_vel)
+def _sign_law(lf: LatentForce, f: np.ndarray, w: np.ndarray, name: str, what: str) -> Shape:
+    """F tanh(w / v_0) (N), v_0 (m/s) scanned from 1e-3 to 1 x the RMS of w."""
+    sv = _rms(w)
     grid = np.geomspace(1e-3 * sv, sv, SCAN_POINTS)
-    v0, coef, fitted, share = _scan(f, lambda v: np.tanh(lf.rel_vel / v)[:, None], grid, lf.band)
-    sentence = (f"a friction-like force F sgn(z') of {coef[0]:.3g} N (smoothed over "
+    v0, coef, fitted, share = _scan(f, lambda v: np.tanh(w / v)[:, None], grid, lf.band)
+    sentence = (f"a friction-like force F sgn({what}) of {coef[0]:.3g} N (smoothed over "
                 f"{1e3 * v0:.2g} mm/s), {_explains(share)}")
-    return Shape("friction", share, {"F_N": coef[0], "v0_m_per_s": v0}, sentence, fitted)
+    return Shape(name, share, {"F_N": coef[0], "v0_m_per_s": v0}, sentence, fitted)
+
+
+def friction(lf: LatentForce, f: np.ndarray) -> Shape:
+    """F tanh(z' / v_0): friction on the velocity relative to the base."""
+    return _sign_law(lf, f, lf.rel_vel, "friction", "z'")
+
+
+def base_velocity(lf: LatentForce) -> np.ndarray:
+    """y' (m/s) from the base acceleration: its integral, high-passed at HIGHPASS_HZ (zero
+    phase) against the integration's drift; zeros for a force input (the base is fixed)."""
+    if lf.input_kind != "base_acc":
+        return np.zeros_like(lf.input)
+    dt = float(lf.time[1] - lf.time[0])
+    v = np.concatenate([[0.0], np.cumsum(0.5 * (lf.input[1:] + lf.input[:-1]) * dt)])
+    sos = signal.butter(2, HIGHPASS_HZ, btype="high", fs=1.0 / dt, output="sos")
+    return signal.sosfiltfilt(sos, v - v.mean())
+
+
+def friction_on_ground(lf: LatentForce, f: np.ndarray) -> Shape:
+    """F tanh(x' / v_0), x' = z' + y': friction on the absolute velocity (a contact fixed to
+    the ground, as on Marino and Cicirello's frame)."""
+    return _sign_law(lf, f, lf.rel_vel + base_velocity(lf), "friction on the ground", "x'")
 
 
 def damping(lf: LatentForce, f: np.ndarray) -> Shape:
@@ -194,14 +228,31 @@ def drift(lf: LatentForce, f: np.ndarray) -> Shape:
                  fitted)
 
 
+def _input_lines(lf: LatentForce, freqs: np.ndarray, n: int, dt: float) -> np.ndarray:
+    """Where ``freqs`` lie within two bins of the input's line and its harmonics, when a line
+    holds most of the input's power (a harmonic excitation: every force of the motion is
+    periodic there, so a line there is no external cause); all False otherwise."""
+    u = lf.input - lf.input.mean()
+    power = np.abs(np.fft.rfft(u, n)) ** 2
+    j = int(np.argmax(power[1:])) + 1
+    width = max(2, n // len(u)) * 2
+    if power[max(j - width, 0): j + width + 1].sum() < INPUT_LINE_SHARE * power.sum():
+        return np.zeros(freqs.size, dtype=bool)
+    f_in = freqs[j]
+    resolution = 2.0 / (len(u) * dt)
+    harmonic = np.round(freqs / f_in)
+    return (harmonic >= 1) & (np.abs(freqs - harmonic * f_in) < resolution)
+
+
 def line(lf: LatentForce, f: np.ndarray) -> Shape:
     """a cos(2 pi f_0 t) + b sin(2 pi f_0 t), f_0 (Hz) at the periodogram's peak (zero-padded
-    8x) refined by least squares."""
+    8x; not at a harmonic excitation's line or its harmonics) refined by least squares."""
     t = lf.time
     dt = float(np.median(np.diff(t)))
     n = 8 * len(t)
     power = np.abs(np.fft.rfft(f - f.mean(), n)) ** 2
     freqs = np.fft.rfftfreq(n, dt)
+    power[_input_lines(lf, freqs, n, dt)] = 0.0
     j = int(np.argmax(power[1:])) + 1
     grid = freqs[max(j - 1, 1): j + 2]
     f0, coef, fitted, share = _scan(f, lambda x: _pair(2.0 * np.pi * x * t), grid, lf.band)
@@ -210,23 +261,33 @@ def line(lf: LatentForce, f: np.ndarray) -> Shape:
     return Shape("line", share, {"frequency_hz": f0, "amplitude_N": amp}, sentence, fitted)
 
 
-def loop(lf: LatentForce, f: np.ndarray) -> Shape:
-    """F h(t): the library's Dahl state at unit force (``hysteresis``) along z', its
-    pre-sliding displacement delta (m) scanned from 1e-3 to 1 x the RMS displacement."""
+def _dahl(lf: LatentForce, f: np.ndarray, w: np.ndarray, name: str, what: str) -> Shape:
+    """F h(t): the library's Dahl state at unit force (``hysteresis``) along the velocity w,
+    its pre-sliding displacement delta (m) scanned from 1e-3 to 1 x the RMS displacement."""
     t_h = term("hysteresis")
     sz = _rms(lf.rel_disp)
     zero = np.zeros_like(lf.time)
+    dt = float(lf.time[1] - lf.time[0])
 
     def basis(delta: float) -> np.ndarray:
         values = {"F_hyst": 1.0, "delta_hyst": delta, "c_hyst": 0.0}
-        return term_force(t_h, values, zero, lf.rel_vel, zero, zero, float(lf.time[1] -
-                                                                           lf.time[0]))[0][:, None]
+        return term_force(t_h, values, zero, w, zero, zero, dt)[0][:, None]
 
     grid = np.geomspace(1e-3 * sz, sz, SCAN_POINTS // 2)
     delta, coef, fitted, share = _scan(f, basis, grid, lf.band)
-    sentence = (f"a hysteresis loop in (z, f), {coef[0]:.3g} N wide at saturation, "
+    sentence = (f"a hysteresis loop in ({what}, f), {coef[0]:.3g} N at saturation, "
                 f"pre-sliding over {1e3 * delta:.2g} mm, {_explains(share)}")
-    return Shape("loop", share, {"F_N": coef[0], "delta_m": delta}, sentence, fitted)
+    return Shape(name, share, {"F_N": coef[0], "delta_m": delta}, sentence, fitted)
+
+
+def loop(lf: LatentForce, f: np.ndarray) -> Shape:
+    """A Dahl loop along z' (pre-sliding friction between the mass and the base)."""
+    return _dahl(lf, f, lf.rel_vel, "loop", "z")
+
+
+def loop_on_ground(lf: LatentForce, f: np.ndarray) -> Shape:
+    """A Dahl loop along x' = z' + y' (stick and slip of a contact fixed to the ground)."""
+    return _dahl(lf, f, lf.rel_vel + base_velocity(lf), "loop on the ground", "x")
 
 
 def inertial(lf: LatentForce, f: np.ndarray) -> Shape:
@@ -244,25 +305,25 @@ def inertial(lf: LatentForce, f: np.ndarray) -> Shape:
 #: -f / M, so a regression on z'' explains any fast force as a large negative mass error (a
 #: Coulomb force of 6 N came out as dM = -10 kg on M = 12.8 kg, 94 %); it serves to check a
 #: named mass error (``describe(lf, DICTIONARY + (inertial,))``).
-DICTIONARY = (odd_in_z, even_in_z, friction, damping, periodic_in_z, drift, line, loop)
+DICTIONARY = (odd_in_z, even_in_z, friction, damping, periodic_in_z, drift, line, loop,
+              friction_on_ground, loop_on_ground)
 
 
 def describe(lf: LatentForce, dictionary=DICTIONARY) -> ShapeDescription:
-    """Every shape of ``dictionary`` fitted to the missing force, best first (a shape later in
+    """Every shape of ``dictionary`` fitted to the missing force less its mean (a constant
+    force, a preload or a sensor's offset, is stated apart), best first (a shape later in
     the dictionary goes first only if it explains SHARE_MARGIN more), and the sentence."""
-    f = lf.force
+    offset = float(np.mean(lf.force))
+    f = lf.force - offset
     fitted = [shape(lf, f) for shape in dictionary]
     ranked = sorted(fitted, key=lambda s: -s.share)
-    best = ranked[0]
-    for s in fitted:  # the earliest shape within the margin of the best
-        if s.share >= best.share - SHARE_MARGIN:
-            best = s
-            break
+    best = next(s for s in fitted if s.share >= ranked[0].share - SHARE_MARGIN)
     ranked = [best] + [s for s in ranked if s is not best]
     rms, sd = lf.rms_N, float(np.mean(lf.sd))
     if rms < 2.0 * sd:
         sentence = (f"no missing force beyond its uncertainty (RMS {rms:.3g} N against an sd "
                     f"of {sd:.3g} N)")
     else:
-        sentence = f"{best.sentence} (RMS {rms:.3g} N)"
-    return ShapeDescription(ranked, rms, sd, sentence)
+        about = f" about a constant {offset:.3g} N" if abs(offset) > 0.1 * rms else ""
+        sentence = f"{best.sentence}{about} (RMS {rms:.3g} N)"
+    return ShapeDescription(ranked, rms, sd, sentence, offset)
