@@ -22,9 +22,9 @@ shares are of what varies.
                     from outside)
 ``loop``            F h(t), h the library's Dahl state (``hysteresis``) at unit force, its
                     pre-sliding displacement delta scanned (a hysteresis loop in (z, f))
-``... on the ground``  friction and loop on the absolute velocity x' = z' + y' (a contact
-                    fixed to the ground: stick holds the mass still, so f = -k z while it
-                    sticks; Marino and Cicirello's frame)
+``... on the ground``  friction, loop and stick-slip on the absolute velocity x' = z' + y'
+                    (a contact fixed to the ground: while it sticks it holds the mass still,
+                    f = -(c_m z' + k z) there; Marino and Cicirello's frame)
 ``inertial``        dM z'' + dm y'' (a mass error, the diagnosis's catch-all name; it is
                     here so that a named mass error can be checked against the force's shape)
 """
@@ -174,14 +174,15 @@ def friction(lf: LatentForce, f: np.ndarray) -> Shape:
 
 
 def base_velocity(lf: LatentForce) -> np.ndarray:
-    """y' (m/s) from the base acceleration: its integral, high-passed at HIGHPASS_HZ (zero
-    phase) against the integration's drift; zeros for a force input (the base is fixed)."""
+    """y' (m/s) from the base acceleration: its integral less its linear trend (the unknown
+    initial velocity, a bias of y''), high-passed at HIGHPASS_HZ (zero phase) against the
+    rest of the drift; zeros for a force input (the base is fixed)."""
     if lf.input_kind != "base_acc":
         return np.zeros_like(lf.input)
     dt = float(lf.time[1] - lf.time[0])
     v = np.concatenate([[0.0], np.cumsum(0.5 * (lf.input[1:] + lf.input[:-1]) * dt)])
     sos = signal.butter(2, HIGHPASS_HZ, btype="high", fs=1.0 / dt, output="sos")
-    return signal.sosfiltfilt(sos, v - v.mean())
+    return signal.sosfiltfilt(sos, signal.detrend(v), padtype="even")
 
 
 def friction_on_ground(lf: LatentForce, f: np.ndarray) -> Shape:
@@ -261,6 +262,42 @@ def line(lf: LatentForce, f: np.ndarray) -> Shape:
     return Shape("line", share, {"frequency_hz": f0, "amplitude_N": amp}, sentence, fitted)
 
 
+def _runs(mask: np.ndarray) -> np.ndarray:
+    """One indicator column per contiguous run of True in ``mask`` (samples, runs)."""
+    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    cols = np.zeros((mask.size, len(starts)))
+    for j, (a, b) in enumerate(zip(starts, stops)):
+        cols[a:b, j] = 1.0
+    return cols
+
+
+def stick_slip_on_ground(lf: LatentForce, f: np.ndarray) -> Shape:
+    """Stick and slip of a contact fixed to the ground (Karnopp): while |x'| < v_s the contact
+    holds the mass where it stuck and carries what eq. (1) then leaves, -(c_m z' + k z) + (M
+    - m) y'' plus k x_stick, a constant per stick phase (its gain b is fitted: 1 is the law);
+    else it slides with F sgn(x'). v_s (m/s) scanned from 1e-3 to 0.5 x the RMS of x'."""
+    x_vel = lf.rel_vel + base_velocity(lf)
+    v = lf.values
+    yb = lf.input if lf.input_kind == "base_acc" else np.zeros_like(lf.input)
+    held = -(v["c_m"] * lf.rel_vel + v["k"] * lf.rel_disp) + (v["M"] - v["m"]) * yb
+
+    def basis(vs: float) -> np.ndarray:
+        stick = np.abs(x_vel) < vs
+        return np.column_stack([np.where(stick, 0.0, np.sign(x_vel)),
+                                np.where(stick, held, 0.0), _runs(stick)])
+
+    sv = _rms(x_vel)
+    vs, coef, fitted, share = _scan(f, basis, np.geomspace(1e-2 * sv, 0.5 * sv,
+                                                           SCAN_POINTS // 2), lf.band)
+    stuck = float(np.mean(np.abs(x_vel) < vs))
+    sentence = (f"stick and slip on the ground: slides at {coef[0]:.3g} N, sticks below "
+                f"{1e3 * vs:.2g} mm/s ({100 * stuck:.0f} % of the time), {_explains(share)}")
+    return Shape("stick-slip on the ground", share, {"F_N": coef[0], "v_stick_m_per_s": vs,
+                                                     "held_gain": coef[1],
+                                                     "stuck_share": stuck}, sentence, fitted)
+
+
 def _dahl(lf: LatentForce, f: np.ndarray, w: np.ndarray, name: str, what: str) -> Shape:
     """F h(t): the library's Dahl state at unit force (``hysteresis``) along the velocity w,
     its pre-sliding displacement delta (m) scanned from 1e-3 to 1 x the RMS displacement."""
@@ -306,7 +343,7 @@ def inertial(lf: LatentForce, f: np.ndarray) -> Shape:
 #: Coulomb force of 6 N came out as dM = -10 kg on M = 12.8 kg, 94 %); it serves to check a
 #: named mass error (``describe(lf, DICTIONARY + (inertial,))``).
 DICTIONARY = (odd_in_z, even_in_z, friction, damping, periodic_in_z, drift, line, loop,
-              friction_on_ground, loop_on_ground)
+              friction_on_ground, loop_on_ground, stick_slip_on_ground)
 
 
 def describe(lf: LatentForce, dictionary=DICTIONARY) -> ShapeDescription:
