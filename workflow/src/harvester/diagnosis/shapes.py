@@ -43,8 +43,6 @@ from harvester.model.terms import term
 
 #: Points of each scanned parameter's grid before the refinement.
 SCAN_POINTS = 40
-#: Cut-off (Hz) of the high-pass that keeps the base velocity integrated from y'' from drifting.
-HIGHPASS_HZ = 0.05
 #: Share of the input's power in its strongest line above which it is a harmonic excitation.
 INPUT_LINE_SHARE = 0.5
 #: A shape is preferred to one earlier in the dictionary only if it explains this much more.
@@ -175,14 +173,15 @@ def friction(lf: LatentForce, f: np.ndarray) -> Shape:
 
 def base_velocity(lf: LatentForce) -> np.ndarray:
     """y' (m/s) from the base acceleration: its integral less its linear trend (the unknown
-    initial velocity, a bias of y''), high-passed at HIGHPASS_HZ (zero phase) against the
-    rest of the drift; zeros for a force input (the base is fixed)."""
+    initial velocity, a bias of y''); zeros for a force input (the base is fixed). A
+    high-pass against further drift (0.05 Hz, zero phase) cost the frame's 1 Hz velocity
+    its shape at the record's ends (correlation 0.85 with y' from the displacement, 0.99996
+    without)."""
     if lf.input_kind != "base_acc":
         return np.zeros_like(lf.input)
     dt = float(lf.time[1] - lf.time[0])
     v = np.concatenate([[0.0], np.cumsum(0.5 * (lf.input[1:] + lf.input[:-1]) * dt)])
-    sos = signal.butter(2, HIGHPASS_HZ, btype="high", fs=1.0 / dt, output="sos")
-    return signal.sosfiltfilt(sos, signal.detrend(v), padtype="even")
+    return signal.detrend(v)
 
 
 def friction_on_ground(lf: LatentForce, f: np.ndarray) -> Shape:
