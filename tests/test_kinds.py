@@ -154,3 +154,23 @@ def test_the_silverbox_reads_in_volts() -> None:
     assert list(rec.data.columns) == ["time", "force", "rel_disp"] and len(rec.data) == 4096
     assert rec.sidecar == {} and "VOLTS" in rec.notes[0]
     assert 1.0 / np.mean(np.diff(rec.data.time)) == pytest.approx(610.35, abs=0.01)
+
+
+def test_harvester_diagnose_takes_displacements_end_to_end(tmp_path, capsys) -> None:
+    """The command on base_disp -> rel_disp (cheapest settings): diagnosis.json in the
+    output's unit, the differentiation in its notes."""
+    import json
+
+    from harvester.cli import main
+    from harvester.data.daq import write_recording
+    rec = tmp_path / "rec.csv"
+    write_recording(displacement_recording(), rec)
+    (tmp_path / "rec.yaml").write_text("M: 12.8\nm: 8.0\nk: 250.0\n")
+    out = tmp_path / "out"
+    assert main(["diagnose", str(rec), "--baseline", "linear", "--out", str(out), "--fast",
+                 "--particles", "40", "--chains", "1", "--no-figures", "--rounds", "1",
+                 "--top", "1"]) == 0
+    doc = json.loads((out / "diagnosis.json").read_text())
+    assert any("second derivative of base_disp" in n for n in doc["notes"])
+    assert "rel_disp, m" in doc["fit"]["likelihood"]
+    assert doc["priors"]["sigma"]["unit"] == "m"

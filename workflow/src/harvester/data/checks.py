@@ -22,6 +22,11 @@ saturation                runs of equal extreme values (a clipped sensor or     
                                                                                 SHARE, else
                                                                                 warning
 spike                     a sample SPIKE_ROBUST_SD robust sd from the median    warning
+drift                     a base displacement's straight-line change over the   warning
+                          record above DRIFT_SHARE of its RMS oscillation
+fast displacement         a displacement whose derivative moves faster than     error with
+                          MAX_VELOCITY_RMS (mm read as m)                       M or m given,
+                                                                                else warning
 unit slip                 the output/input gain above resonance against the     error: median
                           bound M, m, k allow (m/M for base_acc -> rel_acc):    above
                           g against m/s^2, mm against m, kN against N           UNIT_RATIO;
@@ -36,8 +41,10 @@ percentile 0.10); a device with 30 N of friction under 8 m/s^2 0.33 (in g: 3.2, 
 4 m/s^2 0.20 (in g: 2.0, NOT caught); the bundled records 0.4-0.9 and the detection grid's
 scenarios 0.3-1.0 raise nothing.
 
-Gravity left in an acceleration and displacements in mm are ``recording.check_plausible``'s
-(called from here). The sidecar (``RECORDING.yaml``) is checked by ``harvester.data.sidecar``.
+Gravity left in an acceleration and displacements beyond 5 m are
+``recording.check_plausible``'s (called from here). Checks that rest on linear theory (the
+linear FRF fit's m/M, ``harvester.initial.frf``) ask :func:`nonlinearity` first: on a visibly
+nonlinear recording what they find is a warning with that evidence, not an error. The sidecar (``RECORDING.yaml``) is checked by ``harvester.data.sidecar``.
 """
 
 from __future__ import annotations

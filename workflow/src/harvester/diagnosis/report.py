@@ -178,6 +178,16 @@ def _candidate_entries(d) -> list[dict]:
     return out
 
 
+def _output_words(d) -> str:
+    """The output the likelihood compares, in words: its kind, symbol and unit, and the input
+    kind the models are driven by (``harvester.data.kinds``)."""
+    if not d.rounds:
+        return "z''"
+    p = d.rounds[0].state.problem
+    out = p.output_type
+    return f"{out.symbol} ({out.name}, {out.unit}; models driven by {p.input_kind})"
+
+
 def _fit_section(d) -> dict:
     """The fit before and after: parameters, evidence, unseen-data errors."""
     improved_ev = d.improved_fit.log_evidence if d.improved_fit else d.baseline_log_evidence
@@ -187,8 +197,8 @@ def _fit_section(d) -> dict:
                                   "diagnosis" if d.improved_fit else d.baseline_evidence_source,
                                   d.unseen_after),
            "log_evidence_gain": improved_ev - d.baseline_log_evidence,
-           "likelihood": "eq. (10) on z'' through the measurement chain's low-pass, tempered "
-                         "by lambda (effective share of independent samples)"}
+           "likelihood": f"eq. (10) on {_output_words(d)} through the measurement chain's "
+                         "low-pass, tempered by lambda (effective share of independent samples)"}
     if d.improved_fit is not None:
         from harvester.model.terms import term
         added = [p for t in d.improved.terms if t not in d.baseline.terms

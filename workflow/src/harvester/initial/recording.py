@@ -178,8 +178,9 @@ def identification_priors(df: pd.DataFrame, free: tuple[str, ...],
                           ) -> tuple[dict[str, PriorSpec], list[str]]:
     """Priors of the ``free`` parameters (and sigma) of one recording, and where each came from.
 
-    * base_acc -> rel_acc with M, m, k known: c_m, F_c, beta from the recording's FRF
-      (:func:`recording_priors`, as ``harvester diagnose`` does);
+    * M, m, k known (M, k for a force input), any kind of recording: c_m, F_c, beta from the
+      recording's FRF and its power balance (:func:`recording_priors`, as ``harvester
+      diagnose`` does);
     * otherwise the free base parameters (M, m, k, c_m) from a linear FRF fit over
       FRF_BAND_LOW_HZ to FRF_BAND_TOP x the low-pass (``harvester.initial.frf.initial_priors``);
     * sigma: a tenth of the output's sd (``frf.sigma_prior``); the terms' other parameters:
@@ -197,12 +198,13 @@ def identification_priors(df: pd.DataFrame, free: tuple[str, ...],
     kinds = recording_kinds(df, source)
     specs: dict[str, PriorSpec] = {}
     notes: list[str] = []
-    if (kinds.input_kind, kinds.output_kind) == ("base_acc", "rel_acc") and \
-            {"M", "m", "k"} <= set(known):
-        specs.update({k: v for k, v in recording_priors(df, known, {}, source).items()
-                      if k in free})
+    from harvester.data.kinds import input_kind
+    scale = {"M", "k"} if input_kind(kinds.input_kind).force_input else {"M", "m", "k"}
+    if scale <= set(known):  # any kind: recording_priors reads it as the paper's case
+        specs.update({k: v for k, v in recording_priors(df, known, {}, source,
+                                                        lowpass_hz).items() if k in free})
         notes.append(f"priors of {', '.join(specs)}: from the recording's FRF with the known "
-                     "M, m, k (as harvester diagnose)")
+                     f"{', '.join(sorted(scale))} (as harvester diagnose)")
     base = tuple(p for p in ("M", "m", "k", "c_m") if p in free and p not in specs)
     if base:
         top = FRF_BAND_TOP * (lowpass_hz or 0.5 * sampling_rate(df, source))
