@@ -50,3 +50,21 @@ def test_a_relevant_friction_and_a_negligible_mass_error(tmp_path):
     assert entry["shape"]["shapes"][0]["shape"] == "friction"
     assert sorted(p.name for p in tmp_path.iterdir()) == [
         "latent_force.png", "latent_force_coulomb_friction.png", "latent_force_inertia_error.png"]
+
+
+def test_the_diagnosis_baseline_state_goes_through_in_one_call():
+    """quick_detect's own BaselineState (linear baseline fitted by MAP, its c_m driven up to
+    720 N s/m by the friction) on a record of the study's tanh device (Table 5): the missing
+    force is friction-like beside negative viscous damping (8.1 N and -459 N s/m measured,
+    against 11.9 N and 109.5 - 720 = -610 N s/m: the fit shares F and c)."""
+    from harvester.diagnosis import DiagnosisSettings, quick_detect
+    from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
+
+    df, _ = measured_recording(("tanh_friction",), {**TABLE1_KNOWN, **TANH_TABLE5}, 20.0, seed=3)
+    _, state = quick_detect(df, "linear", TABLE1_KNOWN,
+                            settings=DiagnosisSettings(bootstrap=100, seed=0))
+    out = missing_force(state, draws=40)
+    best = out.description.best
+    assert best.name == "friction" and 5.0 < best.parameters["F_N"] < 14.0
+    assert best.parameters["c_N_s_per_m"] < 0.0
+    assert json.loads(json.dumps(out.to_dict()))["latent_force"]["output_kind"] == "rel_acc"
