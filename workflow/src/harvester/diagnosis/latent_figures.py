@@ -7,8 +7,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
 from harvester.diagnosis.latent import LatentForce
 from harvester.diagnosis.latent_views import Binned, EffectForce, views
 from harvester.diagnosis.shapes import ShapeDescription

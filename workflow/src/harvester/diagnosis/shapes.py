@@ -220,8 +220,11 @@ def periodic_in_z(lf: LatentForce, f: np.ndarray) -> Shape:
     grid = span / np.arange(1.0, 200.0, 0.25)
     P, coef, fitted, share = _scan(f, lambda p: _pair(2.0 * np.pi * z / p), grid, lf.band)
     amp = float(np.hypot(*coef))
-    sentence = (f"a force periodic in z, period {1e3 * P:.3g} mm, amplitude {amp:.3g} N, "
-                f"{_explains(share)}")
+    z_sd = float(np.sqrt(np.mean(lf.disp_sd**2)))
+    caveat = (f" (z is known to +-{1e3 * z_sd:.2g} mm only: the amplitude is a lower bound)"
+              if P < 4.0 * z_sd else "")
+    sentence = (f"a force periodic in z, period {1e3 * P:.3g} mm, amplitude {amp:.3g} N"
+                f"{caveat}, {_explains(share)}")
     return Shape("periodic in z", share, {"period_m": P, "amplitude_N": amp}, sentence,
                  fitted)
 
@@ -265,7 +268,10 @@ def line(lf: LatentForce, f: np.ndarray) -> Shape:
     grid = freqs[max(j - 1, 1): j + 2]
     f0, coef, fitted, share = _scan(f, lambda x: _pair(2.0 * np.pi * x * t), grid, lf.band)
     amp = float(np.hypot(*coef))
-    sentence = (f"a line at {f0:.4g} Hz, amplitude {amp:.3g} N, {_explains(share)}")
+    span = float(t[-1] - t[0])
+    what = (f"a slow change (one period in {1.0 / f0:.3g} s over a {span:.3g} s record)"
+            if f0 < 2.0 / span else f"a line at {f0:.4g} Hz")
+    sentence = f"{what}, amplitude {amp:.3g} N, {_explains(share)}"
     return Shape("line", share, {"frequency_hz": f0, "amplitude_N": amp}, sentence, fitted)
 
 
