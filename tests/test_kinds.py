@@ -174,3 +174,20 @@ def test_harvester_diagnose_takes_displacements_end_to_end(tmp_path, capsys) -> 
     assert any("second derivative of base_disp" in n for n in doc["notes"])
     assert "rel_disp, m" in doc["fit"]["likelihood"]
     assert doc["priors"]["sigma"]["unit"] == "m"
+
+
+def test_unknown_masses_get_priors_from_the_recording() -> None:
+    """A device known only through its recordings (issue 41 item 2): M, k not given are
+    identified with the baseline, their priors from the recording's linear FRF fit; a base
+    input with no scale at all is refused."""
+    from test_recording_kinds import TRUTH, synthetic
+    from harvester.initial.recording import diagnosis_priors
+    df = synthetic("force", "rel_disp", n=1600, noise=0.01)
+    specs, notes = diagnosis_priors(df, "linear", {})
+    assert {"M", "k", "c_m"} <= set(specs) and "sigma" not in specs
+    assert "M, k not given" in notes[0]
+    for p in ("M", "k"):
+        assert abs(specs[p].mean - TRUTH[p]) < 2 * specs[p].sd
+    base = synthetic("base_acc", "rel_acc", n=1600)
+    with pytest.raises(ValueError, match="only m/M"):
+        diagnosis_priors(base, "linear", {})

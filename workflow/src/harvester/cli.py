@@ -50,9 +50,8 @@ exit status: 0 done, 2 bad input (named: file, line or column, found, expected).
 
 #: Sampler defaults of the command line (the study's config: 1000 particles x 4 chains).
 CLI_TMCMC = {"particles": 500, "chains": 2, "mcmc_steps": 3, "target_accept": 0.25}
-DIAGNOSE_NEEDS = ("harvester diagnose (its priors of c_m and F_c come from the recording's "
-                  "FRF with M, m, k (M, k for a force input), and its candidates' priors "
-                  "scale with M and k)")
+DIAGNOSE_NEEDS = ("harvester diagnose (with a base input eq. (1) fixes only ratios to a "
+                  "mass: at least one of M, m, k must be known; the others are identified)")
 
 _log_to_file = False
 
@@ -108,7 +107,8 @@ COMMAND_TEXTS: dict[str, tuple[str, str, str]] = {
                  "evidence in nats, where the mismatch lies, the fit before and after; "
                  "notes: warnings and assumptions) and figures. Takes every kind of "
                  "recording (input base_acc, base_disp or force, output rel_acc or rel_disp) "
-                 "and needs M, m, k (M, k for a force input; sidecar or --paper-device)."),
+                 "M, m, k not given (sidecar or --paper-device) are identified, with priors "
+                 "from the recording's FRF (a base input needs one of them known)."),
     "terms": ("list the physics library: terms, equations, units, priors", "harvester terms",
               "prints the base equation and every term"),
     "power": ("power the harvester would make on your base acceleration, per load, with its "
@@ -484,8 +484,9 @@ def _diagnosis_inputs(args: argparse.Namespace):
     accept = Accepted(tuple(INPUTS), tuple(OUTPUTS), "harvester diagnose",
                       "time, one input and one output column")  # every kind
     checked, kp = _read(args.recording, args.paper_device, accept)
-    force = input_kind(checked.kinds.input_kind).force_input
-    kp.require(("M", "k") if force else ("M", "m", "k"), DIAGNOSE_NEEDS, checked.sidecar)
+    if not input_kind(checked.kinds.input_kind).force_input and \
+            not {"M", "m", "k"} & set(kp.values):  # eq. (1) cannot fix the scale
+        kp.require(("M", "m", "k"), DIAGNOSE_NEEDS, checked.sidecar)
     df, lowpass = checked.data, args.filtered_at or checked.sidecar.filtered_at_hz
     notes = [str(w) for w in checked.warnings] + kp.notes(checked.sidecar)
     validation = None
@@ -509,7 +510,7 @@ def _diagnosis_inputs(args: argparse.Namespace):
 def diagnose_command(args: argparse.Namespace) -> int:
     from harvester.data.fileio import atomic_directory, check_output_dir
     from harvester.diagnosis import check_recording, diagnose, write
-    from harvester.initial.recording import recording_priors
+    from harvester.initial.recording import diagnosis_priors
 
     check_output_dir(args.out, inputs=tuple(p for p in (args.recording, args.validation) if p))
     df, validation, lowpass, known, sidecar, notes = _diagnosis_inputs(args)
@@ -517,10 +518,14 @@ def diagnose_command(args: argparse.Namespace) -> int:
     check_recording(df, str(args.recording), settings.lead_in_s,
                     0.0 if validation is not None else settings.holdout_fraction)
     try:
-        priors = recording_priors(df, known, sidecar.priors, str(args.recording),
-                                  settings.lowpass_hz)
+        priors, prior_notes = diagnosis_priors(df, args.baseline, known, sidecar.priors,
+                                               settings.lowpass_hz, str(args.recording))
     except KeyError as err:  # a prior in the sidecar for a parameter the library lacks
         raise DataError(sidecar.path, str(err.args[0])) from None
+    except ValueError as err:  # the FRF fit of unknown M, m, k failed
+        raise DataError(args.recording, f"the priors of the unknown device parameters: "
+                        f"{err}") from None
+    notes += prior_notes
     key = _key(args, Path(args.validation) if args.validation else None)
     with atomic_directory(args.out, key) as stage:
         diag = diagnose(df, args.baseline, known, priors, validation=validation,

@@ -182,8 +182,11 @@ def prepare(recording: pd.DataFrame, validation: pd.DataFrame | None,
                                       settings.holdout_fraction)
     fit_stop = hold if settings.fit_seconds is None else \
         min(hold, lead + int(round(settings.fit_seconds * fs)))
+    detection_raw = make_problem(rec, base, known, window=(lead, hold))
+    # its structure: the baseline with the base parameters ``known`` lacks set free
+    base = detection_raw.structure
     out = Analysis(rec, validation, base, dict(known), dt, lowpass, settings.filter_order,
-                   lead, hold, fit_stop, end, make_problem(rec, base, known, window=(lead, hold)),
+                   lead, hold, fit_stop, end, detection_raw,
                    make_problem(rec, base, known, window=(lead, fit_stop)), notes, floor)
     t = out.time
     log.info("recording %s: %.1f s at %.0f Hz; low-pass %s; analysed %.1f-%.1f s, TMCMC on "

@@ -225,3 +225,38 @@ def identification_priors(df: pd.DataFrame, free: tuple[str, ...],
     if given:
         notes.append(f"priors of {', '.join(given)}: given in the sidecar")
     return specs, notes
+
+
+def diagnosis_priors(df: pd.DataFrame, baseline: str, known: Mapping[str, float],
+                     given: Mapping[str, Mapping[str, float]] | None = None,
+                     lowpass_hz: float | None = None, source: str = "<recording>"
+                     ) -> tuple[dict[str, PriorSpec], list[str]]:
+    """(priors, notes) of ``harvester diagnose`` for any kind of recording: with M, m, k
+    known (M, k for a force input) :func:`recording_priors`; otherwise the missing base
+    parameters are identified, their priors from a linear FRF fit of the recording
+    (:func:`identification_priors`, stated in the notes and in diagnosis.json's priors; a
+    device known only through its recordings, e.g. a circuit in volts). sigma's prior is
+    left to the diagnosis unless ``given``. ValueError where eq. (1) cannot fix the scale (a
+    base input with none of M, m, k, c_m known)."""
+    from harvester.data.kinds import input_kind, model_recording
+    from harvester.data.recording import recording_kinds
+    from harvester.inference.problems import check_identifiable, free_base_parameters
+    from harvester.model.structures import structure
+
+    kinds = recording_kinds(model_recording(df, lowpass_hz, source)[0], source)
+    scale = {"M", "k"} if input_kind(kinds.input_kind).force_input else {"M", "m", "k"}
+    if scale <= set(known):
+        return recording_priors(df, known, given, source, lowpass_hz), []
+    s = structure(baseline)
+    base = free_base_parameters(s, known, kinds.input_kind)
+    check_identifiable(base, kinds.input_kind)
+    free = tuple(dict.fromkeys(base + s.free_parameters))
+    specs, notes = identification_priors(df, free, known, given, lowpass_hz, source)
+    if "sigma" not in (given or {}):
+        specs.pop("sigma", None)
+    missing = sorted(scale - set(known))
+    notes.insert(0, f"{', '.join(missing)} not given: identified with the baseline, their "
+                 "priors from the recording (below)")
+    for line in notes:
+        log.info("%s", line)
+    return specs, notes
