@@ -180,28 +180,26 @@ def validation_dir(group, model, recording):
 def diagnosable(group):
     """Whether a group's diagnosis runs: config groups.<group>.diagnose (default true) and a
     training recording the diagnosis takes (every kind: input base_acc, base_disp or force,
-    output rel_acc or rel_disp; M, m and k known, M and k for a force input)."""
+    output rel_acc or rel_disp). M, m, k not known are identified (their priors the group's);
+    with a base input one of them must be known (eq. 1 fixes only ratios to a mass)."""
     s = GROUPS[group]
     if not s["diagnose"]:
         return False
     if group == STUDY_GROUP:
         return True
     rec = SHEET.groups[group].training
-    need = {"M", "m", "k"}
-    if SHEET.row(rec)["kind"] == "converted":
-        header = recording_header(SHEET.file(rec))
-        if "force" in header:
-            need = {"M", "k"}  # m does not enter eq. (1) with a force input
+    force = SHEET.row(rec)["kind"] == "converted" and \
+        "force" in recording_header(SHEET.file(rec))
     known = set()
     if s["priors"]:
         known = set(yaml.safe_load(Path(s["priors"]).read_text())["known"]) \
             if Path(s["priors"]).exists() else {"M", "m", "k"}
     elif SHEET.sidecar(rec):
         known = set(yaml.safe_load(Path(SHEET.sidecar(rec)).read_text()) or {})
-    if not need <= known:
-        logger.warning(f"group {group}: no diagnosis (it needs {', '.join(sorted(need))} in "
-                       f"the sidecar of {rec}); set groups.{group}.diagnose: false to silence "
-                       "this")
+    if not force and not {"M", "m", "k"} & known:
+        logger.warning(f"group {group}: no diagnosis (with a base input it needs one of M, m, "
+                       f"k in the sidecar of {rec}); set groups.{group}.diagnose: false to "
+                       "silence this")
         return False
     return True
 

@@ -303,8 +303,9 @@ def diagnose_model(data: str | Path, validation: str | Path | None, posterior: s
     known, priors = read_priors(priors_file)
     checked = read_checked_recording(data, known=known, known_from=str(priors_file))
     force = input_kind(checked.kinds.input_kind).force_input  # any kind (data.kinds)
-    KnownParameters(known, known, {}, "").require(("M", "k") if force else ("M", "m", "k"),
-                                                  "the diagnosis", checked.sidecar)
+    if not force and not {"M", "m", "k"} & set(known):  # the others are identified
+        KnownParameters(known, known, {}, "").require(("M", "m", "k"), "the diagnosis",
+                                                      checked.sidecar)
     unseen = None if validation is None else \
         read_checked_recording(validation, known=known, known_from=str(priors_file)).data
     diag_settings = replace(DiagnosisSettings.from_config(settings["diagnosis"]),
