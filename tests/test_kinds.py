@@ -191,3 +191,16 @@ def test_unknown_masses_get_priors_from_the_recording() -> None:
     base = synthetic("base_acc", "rel_acc", n=1600)
     with pytest.raises(ValueError, match="only m/M"):
         diagnosis_priors(base, "linear", {})
+
+
+def test_a_noisy_base_displacement_without_its_low_pass_is_a_warning() -> None:
+    """Differentiating a laser's noise twice: most of base_acc's power near the DAQ's edge is
+    reported with its share; with the recording's low-pass given, nothing is."""
+    t, y, _, _ = _sines()
+    noisy = y + 1e-5 * np.random.default_rng(1).standard_normal(y.size)  # 10 um
+    df = pd.DataFrame({"time": t, "base_disp": noisy, "rel_disp": 0.1 * y})
+    _, notes = model_recording(df, None, "laser.csv")
+    assert len(notes) == 2 and "laser.csv: " in notes[1] and "lies above 25 Hz" in notes[1]
+    assert "sensor's noise" in notes[1] and "filtered_at_hz" in notes[1]
+    assert len(model_recording(df, 20.0)[1]) == 1
+    assert len(model_recording(df.assign(base_disp=y), None)[1]) == 1

@@ -263,12 +263,40 @@ def model_recording(df: pd.DataFrame, lowpass_hz: float | None = None,
     out = df.drop(columns=[kind.name]).copy()
     out.insert(list(df.columns).index(kind.name), kind.model, converted)
     cutoff = chain_cutoff(1.0 / dt, lowpass_hz)
+    notes = [] if lowpass_hz else _amplified_noise(converted, dt, cutoff, kind, source)
     note = (f"{source}: {kind.model} = second derivative of {kind.name} (frequency domain, "
             f"end-to-end line removed, band-limited at {cutoff:.3g} Hz by an order-"
             f"{DERIVATIVE_FILTER_ORDER} zero-phase Butterworth, "
             + ("the recording's low-pass" if lowpass_hz else "the DAQ's anti-alias edge: no "
                "low-pass given (filtered_at_hz)") + f"); RMS {np.std(converted):.4g} m/s^2")
-    return out, [note]
+    return out, [note] + notes
+
+
+#: A derivative holding more than this share of its power above NOISE_BAND_FRACTION x its
+#: cut-off is reported as amplified sensor noise (an excitation rarely lives up there).
+NOISE_POWER_SHARE = 0.5
+NOISE_BAND_FRACTION = 0.25
+
+
+def _amplified_noise(x: np.ndarray, dt: float, cutoff: float, kind: InputKind,
+                     source: str) -> list[str]:
+    """A warning (logged, and returned for the notes) when the derivative of a displacement
+    recorded without a known low-pass holds most of its power near the DAQ's edge: the sensor's
+    noise, amplified by (2 pi f)^2."""
+    import logging
+    from scipy import signal
+    f, p = signal.welch(x, fs=1.0 / dt, nperseg=min(x.size, int(round(2.0 / dt))))
+    edge = NOISE_BAND_FRACTION * cutoff
+    share = float(np.sum(p[f > edge]) / max(np.sum(p), 1e-300))
+    if share <= NOISE_POWER_SHARE:
+        return []
+    text = (f"{source}: {share:.0%} of {kind.model}'s power (the second derivative of "
+            f"{kind.name}) lies above {edge:.3g} Hz, a quarter of the {cutoff:.3g} Hz edge it is "
+            "band-limited at: the displacement sensor's noise, amplified by (2 pi f)^2; give "
+            "the low-pass the recording went through (filtered_at_hz, --filtered-at) or "
+            "low-pass it where its spectrum meets the sensor's floor")
+    logging.getLogger("harvester.data").warning("%s", text)
+    return [text]
 
 
 def paper_case(df: pd.DataFrame, known: Mapping[str, float], lowpass_hz: float | None = None,
