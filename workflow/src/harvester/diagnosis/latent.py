@@ -259,7 +259,7 @@ def _paths(dev: _Device, disc, T, filtered, draws: int, seed: int):
     """Smoothed means (samples, states) and joint draws of the state path (draws, samples,
     states), in SI units."""
     mf, Pf, mp, Pp, _ = filtered
-    ms, _, J, C = rts_smoother(disc.Phi, mf, Pf, mp, Pp)
+    ms, J, C = rts_smoother(disc.Phi, mf, Pf, mp, Pp)
     noise = np.random.default_rng(seed).standard_normal((draws, len(dev.y), len(T)))
     return ms * T, backward_sample(mf, mp, J, C, noise) * T
 

@@ -275,40 +275,64 @@ def line(lf: LatentForce, f: np.ndarray) -> Shape:
     return Shape("line", share, {"frequency_hz": f0, "amplitude_N": amp}, sentence, fitted)
 
 
-def _runs(mask: np.ndarray) -> np.ndarray:
-    """One indicator column per contiguous run of True in ``mask`` (samples, runs)."""
-    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+def _stick_runs(x_vel: np.ndarray, vs: float, shortest: int) -> np.ndarray:
+    """Index of the stick phase each sample is in (-1: sliding): runs of |x'| < v_s at least
+    ``shortest`` samples long (a shorter one is a reversal passing through zero)."""
+    stick = np.abs(x_vel) < vs
+    edges = np.diff(np.concatenate([[0], stick.astype(np.int8), [0]]))
+    runs = np.full(x_vel.size, -1)
     starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
-    cols = np.zeros((mask.size, len(starts)))
-    for j, (a, b) in enumerate(zip(starts, stops)):
-        cols[a:b, j] = 1.0
-    return cols
+    for j, (a, b) in enumerate((a, b) for a, b in zip(starts, stops) if b - a >= shortest):
+        runs[a:b] = j
+    return runs
+
+
+def _stick_slip_fit(f: np.ndarray, x_vel: np.ndarray, held: np.ndarray, runs: np.ndarray
+                    ) -> tuple[float, float, np.ndarray, float]:
+    """(F, b, fitted, share) of f = F sgn(x') while sliding, b held + c_j in stick phase j.
+    The two parts have disjoint supports and c_j is each phase's mean, so the fit is the
+    sliding samples' projection and the phases' demeaned regression (O(samples))."""
+    stick = runs >= 0
+    slide = np.where(stick, 0.0, np.sign(x_vel))
+    F = float(slide @ f / max(slide @ slide, 1e-300))
+    if stick.any():
+        count = np.bincount(runs[stick]).astype(float)
+        mean = lambda x: (np.bincount(runs[stick], x[stick]) / count)[runs[stick]]  # noqa: E731
+        f_dm, h_dm = f[stick] - mean(f), held[stick] - mean(held)
+        b = float(h_dm @ f_dm / max(h_dm @ h_dm, 1e-300))
+        held_part = mean(f) + b * h_dm
+    else:
+        b, held_part = 0.0, np.empty(0)
+    fitted = F * slide
+    fitted[stick] = held_part
+    return F, b, fitted, 1.0 - float(np.sum((f - fitted) ** 2) / max(np.sum(f**2), 1e-300))
+
+
+#: Shortest stick phase (s): a shorter run of |x'| < v_s is a reversal passing through zero.
+SHORTEST_STICK_S = 0.05
 
 
 def stick_slip_on_ground(lf: LatentForce, f: np.ndarray) -> Shape:
-    """Stick and slip of a contact fixed to the ground (Karnopp): while |x'| < v_s the contact
-    holds the mass where it stuck and carries what eq. (1) then leaves, -(c_m z' + k z) + (M
-    - m) y'' plus k x_stick, a constant per stick phase (its gain b is fitted: 1 is the law);
-    else it slides with F sgn(x'). v_s (m/s) scanned from 1e-3 to 0.5 x the RMS of x'."""
+    """Stick and slip of a contact fixed to the ground (Karnopp): while |x'| < v_s (for at
+    least SHORTEST_STICK_S) the contact holds the mass where it stuck and carries what eq. (1)
+    then leaves, b [-(c_m z' + k z) + (M - m) y''] plus a constant per stick phase (k x_stick;
+    b = 1 is the law, fitted and reported); else it slides with F sgn(x'). v_s (m/s) scanned
+    from 1e-2 to 0.5 x the RMS of x'. Fitted without the band (the phases are long)."""
     x_vel = lf.rel_vel + base_velocity(lf)
     v = lf.values
     yb = lf.input if lf.input_kind == "base_acc" else np.zeros_like(lf.input)
     held = -(v["c_m"] * lf.rel_vel + v["k"] * lf.rel_disp) + (v["M"] - v["m"]) * yb
-
-    def basis(vs: float) -> np.ndarray:
-        stick = np.abs(x_vel) < vs
-        return np.column_stack([np.where(stick, 0.0, np.sign(x_vel)),
-                                np.where(stick, held, 0.0), _runs(stick)])
-
+    shortest = max(2, int(round(SHORTEST_STICK_S / float(lf.time[1] - lf.time[0]))))
     sv = _rms(x_vel)
-    vs, coef, fitted, share = _scan(f, basis, np.geomspace(1e-2 * sv, 0.5 * sv,
-                                                           SCAN_POINTS // 2), lf.band)
-    stuck = float(np.mean(np.abs(x_vel) < vs))
-    sentence = (f"stick and slip on the ground: slides at {coef[0]:.3g} N, sticks below "
+    fits = [(vs, *_stick_slip_fit(f, x_vel, held, _stick_runs(x_vel, vs, shortest)))
+            for vs in np.geomspace(1e-2 * sv, 0.5 * sv, SCAN_POINTS)]
+    vs, F, b, fitted, share = max(fits, key=lambda r: r[-1])
+    stuck = float(np.mean(_stick_runs(x_vel, vs, shortest) >= 0))
+    sentence = (f"stick and slip on the ground: slides at {F:.3g} N, sticks below "
                 f"{1e3 * vs:.2g} mm/s ({100 * stuck:.0f} % of the time), {_explains(share)}")
-    return Shape("stick-slip on the ground", share, {"F_N": coef[0], "v_stick_m_per_s": vs,
-                                                     "held_gain": coef[1],
-                                                     "stuck_share": stuck}, sentence, fitted)
+    return Shape("stick-slip on the ground", share, {"F_N": F, "v_stick_m_per_s": vs,
+                                                     "held_gain": b, "stuck_share": stuck},
+                 sentence, fitted)
 
 
 def _dahl(lf: LatentForce, f: np.ndarray, w: np.ndarray, name: str, what: str) -> Shape:
