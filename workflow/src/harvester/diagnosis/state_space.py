@@ -15,9 +15,10 @@ between samples (first-order hold), is exact at the samples as
     x_{k+1} = Phi x_k + G0 d_k + G1 d_{k+1} + w_k,     w_k ~ N(0, Q),
 
 Phi, G0, G1 from one matrix exponential, Q by Van Loan's method. Measurements y_k = H x_k +
-D d_k + N(0, R) where ``measured[k]``. The filter is compiled (Numba); the smoother's gains are solved for all
-samples at once and only its means and the sampler's draws run backwards in Python
-(compiling them cost more than running them).
+D d_k + N(0, R) where ``measured[k]``. The marginal likelihood, evaluated a hundred times
+per fit, is compiled (Numba, plain loops); the filter that stores the path, the smoother
+(its gains solved for all samples at once) and the sampler run once per fit in numpy:
+compiling them cost more than running them.
 """
 
 from __future__ import annotations
@@ -84,7 +85,7 @@ def kalman_filter(Phi, G0, G1, Q, H, D, R, d, y, measured, m0, P0):
     K, loglik, eye = np.zeros(n), 0.0, np.eye(n)
     drive = np.outer(d[:-1], G0) + np.outer(d[1:], G1)
     period = None  # (first sample of a repeating measurement cycle, its length)
-    last = None
+    last, S_steady, K_steady = None, 1.0, K
     for k in range(N):
         if k > 0:
             m = Phi @ m + drive[k - 1]
