@@ -14,7 +14,8 @@ from harvester.diagnosis.baseline import ChainProblem, baseline_state
 from harvester.diagnosis.latent import latent_force
 from harvester.diagnosis.latent_views import binned, effect_force, views
 from harvester.diagnosis.shapes import describe
-from harvester.diagnosis.state_space import discretise, matern
+from harvester.diagnosis.state_space import (discretise, kalman_filter, kalman_loglik, matern,
+                                             rts_smoother)
 from harvester.diagnosis.term_forces import model_force
 from harvester.inference.likelihood import DAQ_OVERSAMPLE
 from harvester.model.simulate import simulate
@@ -71,6 +72,26 @@ def test_the_state_space_is_the_matern_process():
     # the drive's first-order hold: a constant input over a step of x' = -x + d
     d = discretise(np.array([[-1.0]]), np.array([1.0]), np.zeros((1, 1)), 0.5)
     assert d.G0[0] + d.G1[0] == pytest.approx(1.0 - np.exp(-0.5))
+
+
+def test_the_filter_and_the_compiled_likelihood_agree():
+    """The path-storing filter (numpy, covariances copied once their cycle repeats) and the
+    compiled likelihood (gain frozen once steady) give the same marginal likelihood; the
+    smoother's means lie closer to the signal than the data."""
+    F, q, P = matern("matern32", 0.05, 1.0)
+    W = np.zeros((2, 2))
+    W[-1, -1] = q
+    d = discretise(F, np.zeros(2), W, 1.0 / FS)
+    rng = np.random.default_rng(0)
+    y = np.sin(np.arange(2000) / 20.0) + 0.3 * rng.standard_normal(2000)
+    H, drive = np.array([1.0, 0.0]), np.zeros(2000)
+    measured = np.arange(2000) % 4 == 0
+    mf, Pf, mp, Pp, ll = kalman_filter(d.Phi, d.G0, d.G1, d.Q, H, 0.0, 0.09, drive, y,
+                                       measured, np.zeros(2), P)
+    assert ll == pytest.approx(kalman_loglik(d.Phi, d.G0, d.G1, d.Q, H, 0.0, 0.09, drive, y,
+                                             4, np.zeros(2), P), abs=1e-6)
+    ms, J, C = rts_smoother(d.Phi, mf, Pf, mp, Pp)
+    assert np.std(ms[:, 0] - np.sin(np.arange(2000) / 20.0)) < 0.25  # the noise: 0.3
 
 
 def test_terms_forces_close_eq1_along_a_simulated_path():
