@@ -109,6 +109,16 @@ def test_cli_end_to_end_writes_diagnosis_json(recording, tmp_path, capsys):
     assert isinstance(d["missing"], list) and all(isinstance(m, str) for m in d["missing"])
     # a linear model of a friction device is not adequate, and friction is what it misses
     assert d["verdict"] == "missing_physics"
+    # the missing force in newtons, the friction's size beside it, and one page with all of it
+    mf = d["missing_force"]
+    assert mf["latent_force"] and mf["shape"]["sentence"]
+    sizes = {e["term"]: e for e in mf["named_effects"]}
+    if d["missing"]:
+        assert sizes[d["missing"][0]]["relevance"] == "relevant"
+        assert sizes[d["missing"][0]]["force_rms_N"] > 1.0
+    page = (out / "summary.html").read_text()
+    assert d["headline"] in page.replace("&#x27;", "'") and "data:image/png;base64," in page
+    assert (out / "latent_force.png").is_file() and "latent_force.png" in d["figures"]
     for c in d["candidates"]:
         assert isinstance(c["effect"], str)
         for key in ("log_evidence", "delta_log_evidence", "log_evidence_tmcmc"):

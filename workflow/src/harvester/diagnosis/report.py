@@ -238,6 +238,7 @@ def _diagnosis_dict(d) -> dict:
         "unseen_nrmse": None if judged is None else judged.nrmse,
         "noise_floor": None if judged is None or judged.floor is None else judged.floor.to_dict(),
         "fit_judgement": None if judged is None else judged.to_dict(s.floor_ratio),
+        "missing_force": None if d.missing_force is None else d.missing_force.to_dict(),
         "missing": d.missing,
         "indistinguishable": d.indistinguishable,
         "ties": [tie.to_dict() for tie in d.ties],

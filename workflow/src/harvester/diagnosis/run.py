@@ -34,6 +34,8 @@ from harvester.diagnosis.settings import DiagnosisSettings
 from harvester.diagnosis.signatures import candidate_terms
 from harvester.diagnosis.spectral import filter_cutoff
 from harvester.diagnosis.floor import output_floor
+from harvester.diagnosis.missing_force import MissingForce, NamedEffect, missing_force
+from harvester.diagnosis.relevance import RelevanceFloor
 from harvester.diagnosis.verdict import (Conclusion, FitJudgement, Tie, conclude,
                                           decide_verdict, judge)
 from harvester.inference.problems import make_problem
@@ -79,6 +81,7 @@ class Diagnosis:
     figure_files: list[str] = field(default_factory=list)
     headline: str = ""
     fit_judgement: FitJudgement | None = None
+    missing_force: MissingForce | None = None
 
     @property
     def indistinguishable(self) -> list[list[str]]:
@@ -112,11 +115,14 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
     found = conclude(rounds, unexplained, settings, analysis.f_high)
     before, after, unseen_notes = unseen_comparison(analysis, start, found.improved_fit,
                                                     settings)
+    missing, missing_notes = estimate_missing_force(analysis, rounds[0].state, found, settings)
     found = judge(found, rounds[0].detection, fit_judgement(start, rounds[0], before, after),
-                  analysis.structure.name, settings)
+                  analysis.structure.name, settings, missing)
+    unseen_notes += missing_notes
     diag = _diagnosis(analysis, start, rounds, baseline_fit, found, (before, after), settings,
                       analysis.notes + notes + found.notes + unseen_notes,
                       time.perf_counter() - clock)
+    diag.missing_force = missing
     log.info("verdict: %s%s (%.0f s)", diag.headline,
              "".join(f"; cannot tell apart {' / '.join(t.effects)}" for t in diag.ties),
              diag.seconds)
@@ -158,6 +164,31 @@ def fit_judgement(start: BaselineStart, first: Round, before: UnseenFit | None,
     return FitJudgement(share, None if before is None else before.nrmse,
                         None if before is None else before.data, first.detection.sigma, found,
                         improved)
+
+
+def estimate_missing_force(a: Analysis, state: BaselineState, found: Conclusion,
+                           settings: DiagnosisSettings) -> tuple[MissingForce | None, list[str]]:
+    """The baseline's missing force (``missing_force``) over the analysed window, with each
+    effect the improved model added beside it and its size on the unseen input (the validation
+    record's or the held-out tail's); None with a note where it cannot be estimated."""
+    if not settings.missing_force:
+        return None, []
+    imp = found.improved_fit
+    named = [] if imp is None else [
+        NamedEffect(t, imp.structure, imp.samples.mean(axis=0))
+        for t in imp.structure.terms if t not in a.structure.terms]
+    rec, window = ((a.validation, slice(int(round(settings.lead_in_s / a.dt)), None))
+                   if a.validation is not None else (a.recording, slice(a.hold, a.end)))
+    clock = time.perf_counter()
+    try:
+        out = missing_force(state, (a.lead, a.hold), named, rec.iloc[:, 1].to_numpy(), window,
+                            RelevanceFloor(settings.relevance_share, settings.relevance_share,
+                                           settings.relevance_share > 0))
+    except (NotImplementedError, RuntimeError, ValueError, np.linalg.LinAlgError) as err:
+        log.warning("missing force not estimated: %s", err)
+        return None, [f"missing force not estimated: {err}"]
+    log.info("missing force: %s (%.1f s)", out.description.sentence, time.perf_counter() - clock)
+    return out, []
 
 
 def unseen_comparison(a: Analysis, start: BaselineStart, improved: ModelFit | None,
@@ -228,6 +259,11 @@ def write(diag: Diagnosis, out_dir: str | Path, title: str | None = None) -> Pat
     if diag.settings.figures:
         from harvester.diagnosis.figures import all_figures
         diag.notes.extend(all_figures(diag, out))
+        if diag.missing_force is not None:
+            from harvester.diagnosis.latent_figures import all_latent_figures
+            mf = diag.missing_force
+            mf.figure_files = all_latent_figures(mf.latent, mf.description, out, mf.effects)
+            diag.figure_files.extend(mf.figure_files)
     path = out / "diagnosis.json"
     doc = diag.to_dict()
     write_json(doc, path)

@@ -24,6 +24,11 @@ class DiagnosisSettings:
     less of the unseen output than this share (1 - NRMSE^2) is "inadequate", unless its residual
     lies within ``floor_ratio`` of the recording's own noise floor (``floor.py``); floor_ratio:
     a residual RMS above this many times that floor is mismatch whatever the detection says;
+    relevance_share: a named effect whose force (share of the drive) and change of the unseen
+    response (share of the output) both lie below this share is "detectable but negligible",
+    not missing physics (``relevance.RelevanceFloor``; 0: off); missing_force: estimate the
+    missing force of the baseline as a latent force, its shape and each named effect's size
+    (``missing_force``);
     lead_in_s: start of the analysis (the model
     starts at rest); fit_seconds: most seconds of the recording TMCMC fits (None, the default:
     the whole window the detection analyses, all but the holdout); holdout_fraction: share of
@@ -56,6 +61,8 @@ class DiagnosisSettings:
     unexplained_alpha: float = 0.001
     min_explained_share: float = 0.5
     floor_ratio: float = 3.0
+    relevance_share: float = 0.01
+    missing_force: bool = True
     window_s: float = DetectionSettings.window_s
     lead_in_s: float = 1.0
     fit_seconds: float | None = None

@@ -20,11 +20,10 @@ from typing import Any
 SECTIONS: tuple[tuple[str, tuple[tuple[str, str], ...]], ...] = (
     ("The missing force", (
         ("latent_force.png", "The force the baseline would need to reproduce the recording "
-         "(N), with its 95 % band; a band that holds zero throughout means nothing is "
-         "missing."),
-        ("latent_views.png", "That force against the states: a shape against velocity is "
-         "friction or damping, against displacement a spring or a contact, a loop in (z, f) "
-         "hysteresis."),
+         "(N, grey, +-2 sd shaded; the best-fitting shape in black), then the same force "
+         "against the states: a shape against velocity is friction or damping, against "
+         "displacement a spring or a contact, a loop in (z, f) hysteresis; a band that holds "
+         "zero throughout means nothing is missing."),
     )),
     ("Where the mismatch lies", (
         ("residual_windows.png", "Share of the residual's energy per time window against "
@@ -47,6 +46,12 @@ SECTIONS: tuple[tuple[str, tuple[tuple[str, str], ...]], ...] = (
 )
 
 
+#: How to read a named effect's force beside the missing force (``latent_force_TERM.png``).
+EFFECT_FORCE = ("The named term's fitted force (black) beside the missing force (grey, band "
+                "shaded), in time and against z' and z: where they agree, the term took the "
+                "shape of what was missing; where they part, the name is doubtful.")
+
+
 def _esc(x: Any) -> str:
     return html.escape(str(x))
 
@@ -58,10 +63,17 @@ def _figure(path: Path, how: str) -> str:
 
 
 def _missing_lines(doc: Mapping[str, Any]) -> list[str]:
-    """What is missing: each named effect with what it implies, each tie with its members."""
+    """What is missing: each named effect with what it implies and its size, each tie with
+    its members, and the missing force's shape."""
     cands = {c.get("effect"): c for c in doc.get("candidates") or []}
+    mf = doc.get("missing_force") or {}
+    sizes = {e.get("term"): e for e in mf.get("named_effects") or []}
     lines = [f"<b>{_esc(e)}</b>: {_esc((cands.get(e) or {}).get('implies', ''))}"
+             + (f"<br>size: {_esc(sizes[e]['sentence'])}" if e in sizes else "")
              for e in doc.get("missing") or []]
+    if (mf.get("shape") or {}).get("sentence"):
+        lines.append(f"the missing force, seen without the library: "
+                     f"{_esc(mf['shape']['sentence'])}")
     for tie in doc.get("ties") or []:
         lines.append("cannot tell apart " + " / ".join(_esc(e) for e in tie.get("effects", []))
                      + (f"; the experiment that would: {_esc(tie['recommended'])}"
@@ -111,10 +123,14 @@ def summary_page(doc: Mapping[str, Any], figure_dir: str | Path, title: str) -> 
             f'<p class="headline">{_esc(doc.get("headline") or doc.get("verdict"))}</p>',
             "<h2>What is missing</h2><ul>"
             + "".join(f"<li>{line}</li>" for line in _missing_lines(doc)) + "</ul>"]
-    listed = {name for _, figs in SECTIONS for name, _ in figs}
+    listed = {name for _, figs in SECTIONS for name, _ in figs} | {
+        p.name for p in figure_dir.glob("latent_force_*.png")}
     for section, figs in SECTIONS:
         parts = [_figure(figure_dir / name, how) for name, how in figs
                  if (figure_dir / name).is_file()]
+        if section == "The missing force":
+            parts += [_figure(path, EFFECT_FORCE) for path in
+                      sorted(figure_dir.glob("latent_force_*.png"))]
         if section == "The candidates":
             parts.insert(0, _candidate_rows(doc))
         if section.startswith("The fit"):

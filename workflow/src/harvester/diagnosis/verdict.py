@@ -25,6 +25,7 @@ from harvester.diagnosis.confirm import CandidateResult
 from harvester.diagnosis.fits import ModelFit
 from harvester.diagnosis.detect import Detection
 from harvester.diagnosis.floor import Floor
+from harvester.diagnosis.missing_force import MissingForce
 from harvester.diagnosis.rounds import Round
 from harvester.diagnosis.separate import Separation, separations
 from harvester.diagnosis.settings import DiagnosisSettings
@@ -174,15 +175,21 @@ def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings
 
 
 def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
-          settings: DiagnosisSettings) -> Conclusion:
-    """The verdict with the fit on unseen data and the noise floor weighed in
-    (``decide_verdict``), its notes and headline."""
+          settings: DiagnosisSettings, missing: MissingForce | None = None) -> Conclusion:
+    """The verdict with the fit on unseen data, the noise floor and the named effects'
+    relevance weighed in (``decide_verdict``), its notes and headline. ``missing``: the
+    missing force with each named effect's size (``missing_force``); an accepted effect
+    counts as missing physics only if one of them is relevant."""
     limit = settings.floor_ratio
     above, within = fit.above(limit), fit.within(limit)
-    verdict = decide_verdict(first.p_value, found.accepted, settings.unexplained_alpha,
-                             explained=fit.explained, min_explained=settings.min_explained_share,
+    sizes = missing.sizes if missing is not None else []
+    relevant = not sizes or any(not s.negligible for s in sizes)
+    verdict = decide_verdict(first.p_value, found.accepted and relevant,
+                             settings.unexplained_alpha, explained=fit.explained,
+                             min_explained=settings.min_explained_share,
                              above_floor=above, within_floor=within)
     notes, unexplained = list(found.notes), found.unexplained
+    notes += [f"detectable but negligible: {s.sentence()}" for s in sizes if s.negligible]
     if above and not found.accepted:
         unexplained = True
         notes.append(f"the residual is {fit.ratio:.3g} x the recording's noise floor "
@@ -204,11 +211,23 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
                      "periods, quiet lead-in or white band): the verdict rests on the "
                      "detection's replicates and on the share of unseen data explained")
     return replace(found, verdict=verdict, unexplained=bool(unexplained), notes=notes, fit=fit,
-                   headline=headline(verdict, found, fit, baseline, limit))
+                   headline=headline(verdict, found, fit, baseline, limit, missing))
+
+
+def _named(found: Conclusion, missing: MissingForce | None) -> str:
+    """The effects named and tied, each with its size where the missing force gave it."""
+    sizes = {s.term: s for s in (missing.sizes if missing is not None else [])}
+    out = []
+    for effect in found.missing:
+        s = sizes.get(effect)
+        out.append(effect if s is None else
+                   f"{effect} ({s.force_rms_N:.3g} N RMS, {s.share_of_drive:.2%} of the drive, "
+                   f"{s.label})")
+    return ", ".join(out + [" / ".join(t.effects) for t in found.ties])
 
 
 def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
-             limit: float) -> str:
+             limit: float, missing: MissingForce | None = None) -> str:
     """One line: the verdict, the share of the unseen output the baseline explains, and the
     noise floor it was judged against."""
     parts = [verdict]
@@ -224,11 +243,12 @@ def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
     else:
         parts.append("no independent noise floor measured")
     if found.missing or found.ties:
-        named = found.missing + [" / ".join(t.effects) for t in found.ties]
-        parts.append("missing: " + ", ".join(named))
+        parts.append("missing: " + _named(found, missing))
     share = fit.library_share()
     if verdict != "adequate":
         parts.append(_library_phrase(share, found.accepted))
+        if not found.accepted and missing is not None:
+            parts.append(f"the missing force: {missing.description.sentence}")
     return "; ".join(parts)
 
 
