@@ -3,8 +3,12 @@
 from __future__ import annotations
 
 import re
+import shutil
+import subprocess
 
 import matplotlib
+import numpy as np
+import pytest
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -54,3 +58,35 @@ def test_sections_without_figures_are_left_out(tmp_path):
     page = summary_page({**DOC, "figures": []}, tmp_path, "t")
     assert "data:image" not in page and "The missing force" not in page
     assert "<h2>The candidates</h2><table>" in page  # the table stands without its figure
+
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="no chromium on this machine (.ci/run installs it)")
+def test_the_page_renders_in_a_real_browser(tmp_path):
+    """Headless Chromium opens the page alone (no file beside it): the headline is in its
+    DOM first, and the embedded figure is drawn (a black square covering a known share of the
+    screenshot; a broken image would leave the page white)."""
+    fig_dir = tmp_path / "figs"
+    fig_dir.mkdir()
+    fig = plt.figure(figsize=(4, 4), dpi=100)
+    fig.add_axes([0, 0, 1, 1]).add_patch(plt.Rectangle((0, 0), 1, 1, color="black"))
+    fig.savefig(fig_dir / "candidates.png")
+    plt.close(fig)
+    page = tmp_path / "alone" / "summary.html"
+    page.parent.mkdir()
+    page.write_text(summary_page({**DOC, "figures": []}, fig_dir, "Diagnosis of linear"))
+    shot = tmp_path / "shot.png"
+    args = [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+            "--window-size=1000,2000"]
+    dom = subprocess.run(args + ["--dump-dom", page.as_uri()], capture_output=True, text=True,
+                         timeout=120).stdout
+    subprocess.run(args + [f"--screenshot={shot}", page.as_uri()], capture_output=True,
+                   timeout=120, check=True)
+    body = dom[dom.index("<body>"):]
+    assert body.index('class="headline"') < body.index("<h2>")
+    assert "linear explains 94 %" in body
+    pixels = plt.imread(shot)[..., :3]
+    dark = float(np.mean(pixels.max(axis=-1) < 0.1))
+    assert dark > 0.05, f"only {dark:.1%} of the screenshot is dark: the figure was not drawn"
