@@ -147,6 +147,23 @@ def test_a_linear_recording_with_an_impossible_mass_ratio_is_still_an_error() ->
                        (2.0, 40.0))
 
 
+@pytest.mark.skipif(not FRAME.is_dir(), reason="no ../shared/data/marino-frame")
+def test_the_frame_with_its_friction_on_the_ground_is_a_force_input() -> None:
+    """M x'' + C x' + K x + F_f(x') = K y + C y': force -> rel_disp (x), every friction term
+    then acting on x'; it passes the checks (the lasers' common noise above 10 Hz is
+    filtered out)."""
+    from harvester.data.public import FRAME_GROUND_LOWPASS_HZ, marino_frame
+    rec = marino_frame(FRAME, 450, friction_on="ground")
+    assert list(rec.data.columns) == ["time", "force", "rel_disp"]
+    assert rec.sidecar == {"M": 3.0799, "k": 1191.0, "filtered_at_hz": FRAME_GROUND_LOWPASS_HZ}
+    assert 1.0 < rec.data.force.std() < 2.0  # N: K y with y about 1.3 mm RMS
+    kinds = RecordingKinds("force", "rel_disp")
+    assert checks.check_recording(rec.data, kinds, 0.004, "frame", rec.sidecar,
+                                  lowpass_hz=rec.sidecar["filtered_at_hz"]) == []
+    with pytest.raises(ValueError, match="'base' or 'ground'"):
+        marino_frame(FRAME, 450, friction_on="storey")
+
+
 @pytest.mark.skipif(not SILVERBOX.is_file(), reason="no ../shared/data/silverbox")
 def test_the_silverbox_reads_in_volts() -> None:
     from harvester.data.public import silverbox
