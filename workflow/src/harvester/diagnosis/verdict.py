@@ -217,13 +217,14 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
 def _named(found: Conclusion, missing: MissingForce | None) -> str:
     """The effects named and tied, each with its size where the missing force gave it."""
     sizes = {s.term: s for s in (missing.sizes if missing is not None else [])}
+    groups = [[e] for e in found.missing] + [t.effects for t in found.ties]
     out = []
-    for effect in found.missing:
-        s = sizes.get(effect)
-        out.append(effect if s is None else
-                   f"{effect} ({s.force_rms_N:.3g} N RMS, {s.share_of_drive:.2%} of the drive, "
-                   f"{s.label})")
-    return ", ".join(out + [" / ".join(t.effects) for t in found.ties])
+    for effects in groups:
+        s = next((sizes[e] for e in effects if e in sizes), None)
+        out.append(" / ".join(effects) + ("" if s is None else
+                   f" ({s.term} {s.force_rms_N:.3g} N RMS, {s.share_of_drive:.2%} of the "
+                   f"drive, {s.label})"))
+    return ", ".join(out)
 
 
 def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
@@ -243,7 +244,9 @@ def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
     else:
         parts.append("no independent noise floor measured")
     if found.missing or found.ties:
-        parts.append("missing: " + _named(found, missing))
+        # accepted effects below the relevance floor leave the verdict adequate
+        label = "missing" if verdict != "adequate" else "detectable but negligible"
+        parts.append(f"{label}: " + _named(found, missing))
     share = fit.library_share()
     if verdict != "adequate":
         parts.append(_library_phrase(share, found.accepted))
