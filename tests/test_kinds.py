@@ -221,3 +221,26 @@ def test_a_noisy_base_displacement_without_its_low_pass_is_a_warning() -> None:
     assert "sensor's noise" in notes[1] and "filtered_at_hz" in notes[1]
     assert len(model_recording(df, 20.0)[1]) == 1
     assert len(model_recording(df.assign(base_disp=y), None)[1]) == 1
+
+
+def test_friction_on_the_ground_from_the_sidecar(tmp_path) -> None:
+    """The sidecar's friction_on: ground rewrites base_disp -> rel_disp in absolute
+    coordinates (force k y, output x = z + y); a bad value or another kind is refused."""
+    from harvester.data.kinds import on_ground
+    from harvester.data.sidecar import read_sidecar
+    t, y, _, _ = _sines()
+    df = pd.DataFrame({"time": t, "base_disp": y, "rel_disp": -0.5 * y})
+    out, known, notes = on_ground(df, {"M": 3.0, "m": 3.0, "k": 1000.0}, "rec.csv")
+    assert list(out.columns) == ["time", "force", "rel_disp"] and "m" not in known
+    assert np.allclose(out.force, 1000.0 * (y - y.mean()))
+    assert np.allclose(out.rel_disp, 0.5 * y - np.mean(0.5 * y))
+    assert "friction on the ground" in notes[0]
+    with pytest.raises(DataError, match="needs base_disp and rel_disp"):
+        on_ground(df.rename(columns={"base_disp": "base_acc"}), {"k": 1.0})
+    with pytest.raises(DataError, match="needs k known"):
+        on_ground(df, {"M": 3.0})
+    (tmp_path / "r.yaml").write_text("k: 1000\nfriction_on: ground\n")
+    assert read_sidecar(tmp_path / "r.csv").friction_on == "ground"
+    (tmp_path / "r.yaml").write_text("k: 1000\nfriction_on: storey\n")
+    with pytest.raises(DataError, match="line 2.*'friction_on' must be base or ground"):
+        read_sidecar(tmp_path / "r.csv")

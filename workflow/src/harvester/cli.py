@@ -43,7 +43,8 @@ recording: a CSV file, comma-separated, '.' as the decimal point, with a header:
   rel_disp  m       output: displacement of the mass relative to the base
   (other columns are carried along unused).
 sidecar RECORDING.yaml beside it (optional): M (kg), m (kg), k (N/m), priors
-  ({name: {mean, sd}}), filtered_at_hz (Hz). Device parameters it does not give are
+  ({name: {mean, sd}}), filtered_at_hz (Hz), friction_on (base or ground: what the
+  friction acts on; ground: diagnose rewrites base_disp -> rel_disp as force k y -> x). Device parameters it does not give are
   identified, or must be given, or assumed with --paper-device (the paper's Table 1:
   M 12.8 kg, m 8 kg, k 250 N/m); what was assumed is logged and written to the output.
 exit status: 0 done, 2 bad input (named: file, line or column, found, expected)."""
@@ -504,7 +505,16 @@ def _diagnosis_inputs(args: argparse.Namespace):
             validation = filter_recording(validation, args.lowpass, args.filter_order,
                                           str(args.validation), output)
         lowpass = args.lowpass
-    return df, validation, lowpass, kp.values, checked.sidecar, notes
+    known = kp.values
+    if checked.sidecar.friction_on == "ground":  # the device's friction acts on x'
+        from harvester.data.kinds import on_ground
+        df, known, done = on_ground(df, kp.values, str(args.recording))
+        if validation is not None:
+            validation, _, _ = on_ground(validation, kp.values, str(args.validation))
+        for line in done:
+            log.info("%s", line)
+        notes += done
+    return df, validation, lowpass, known, checked.sidecar, notes
 
 
 def diagnose_command(args: argparse.Namespace) -> int:

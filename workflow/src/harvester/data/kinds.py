@@ -320,3 +320,34 @@ def paper_case(df: pd.DataFrame, known: Mapping[str, float], lowpass_hz: float |
     y = out.to_acceleration(df[out.name].to_numpy(dtype=float), dt, lowpass_hz)
     return pd.DataFrame({"time": df["time"].to_numpy(dtype=float), "base_acc": u,
                          "rel_acc": y}), known
+
+
+def on_ground(df: pd.DataFrame, known: Mapping[str, float], source: str = "<recording>"
+              ) -> tuple[pd.DataFrame, dict[str, float], list[str]]:
+    """(recording, known, notes) of a device whose friction acts on the mass's own velocity
+    (a contact fixed to the ground; the sidecar's ``friction_on: ground``): a base_disp ->
+    rel_disp recording rewritten in absolute coordinates, where eq. (1) with m = M,
+    M x'' + c (x' - y') + k (x - y) + F_f(x') = 0, is M x'' + c x' + k x + F_f(x') =
+    k y + c y': driven by the force F = k y (N; the c y' part is left out, as the model's c_m
+    is identified) with the output x = z + y (m), so that every friction term acts on x'.
+    Needs k known; m is then unused (and M = m is assumed: a frame, not a screw). DataError
+    for other kinds. A copy; the recording passed in is not changed."""
+    from harvester.data.errors import DataError
+    from harvester.data.recording import recording_kinds
+    kinds = recording_kinds(df, source)
+    if (kinds.input_kind, kinds.output_kind) != ("base_disp", "rel_disp"):
+        raise DataError(source, f"friction_on: ground needs base_disp and rel_disp (the "
+                        f"mass's absolute displacement is their sum), this recording has "
+                        f"{kinds.input_kind} and {kinds.output_kind}", column=kinds.input_kind)
+    if "k" not in known:
+        raise DataError(source, "friction_on: ground needs k known (the force k y drives the "
+                        "mass in absolute coordinates): give k in the sidecar")
+    y = df["base_disp"].to_numpy(dtype=float)
+    x = df["rel_disp"].to_numpy(dtype=float) + y
+    out = pd.DataFrame({"time": df["time"].to_numpy(dtype=float),
+                        "force": float(known["k"]) * (y - np.mean(y)), "rel_disp": x - np.mean(x)})
+    known = {p: v for p, v in known.items() if p != "m"}
+    note = (f"{source}: friction on the ground (sidecar friction_on): driven by the force "
+            f"k y (k = {known['k']:g} N/m, RMS {np.std(out.force):.4g} N) with the output "
+            "x = rel_disp + base_disp (m, about its mean), so that friction acts on x'")
+    return out, known, [note]

@@ -10,6 +10,10 @@ m              kg     oscillating mass (M >= m)
 k              N/m    spring stiffness
 priors                ``{parameter: {mean, sd}}``, e.g. a static test's ``F_c``
 filtered_at_hz Hz     cut-off of a zero-phase low-pass the recording already went through
+friction_on           ``base`` (default) or ``ground``: what the device's friction acts on,
+                      the velocity relative to the base, or the mass's own (a contact fixed
+                      to the ground, as on the frame of Marino and Cicirello);
+                      ``harvester.data.kinds.on_ground`` writes such a recording
 ============== ====== ===================================================================
 
 Parameters the sidecar does not give are identified where the method can (``harvester
@@ -34,6 +38,7 @@ log = logging.getLogger("harvester.data.sidecar")
 SIDECAR_KEYS: dict[str, str] = {
     "M": "effective mass (kg)", "m": "oscillating mass (kg)", "k": "stiffness (N/m)",
     "priors": "{parameter: {mean, sd}}", "filtered_at_hz": "low-pass already applied (Hz)",
+    "friction_on": "base or ground (what the friction acts on)",
 }
 #: Device parameters a sidecar may give, with their units.
 DEVICE_PARAMETERS: dict[str, str] = {"M": "kg", "m": "kg", "k": "N/m"}
@@ -48,11 +53,13 @@ class Sidecar:
     known: dict[str, float] = field(default_factory=dict)
     priors: dict[str, dict[str, float]] = field(default_factory=dict)
     filtered_at_hz: float | None = None
+    friction_on: str = "base"
 
     def summary(self) -> dict[str, Any]:
         """For run.json: where it is and what it gave."""
         return {"path": str(self.path), "found": self.found, "known": dict(self.known),
-                "priors": dict(self.priors), "filtered_at_hz": self.filtered_at_hz}
+                "priors": dict(self.priors), "filtered_at_hz": self.filtered_at_hz,
+                "friction_on": self.friction_on}
 
 
 def sidecar_path(recording: str | Path) -> Path:
@@ -132,9 +139,14 @@ def read_sidecar(recording: str | Path) -> Sidecar:
         raise DataError(path, f"m = {known['m']:g} kg > M = {known['M']:g} kg: impossible, the "
                         "effective mass M = m + J (2 pi / l)^2 includes m", line=lines.get("m"))
     cutoff = meta.get("filtered_at_hz")
+    friction_on = meta.get("friction_on", "base")
+    if friction_on not in ("base", "ground"):
+        raise DataError(path, f"'friction_on' must be base or ground (what the device's "
+                        f"friction acts on), got {friction_on!r}", line=lines.get("friction_on"))
     return Sidecar(path, True, known, _priors(path, meta.get("priors", {}), lines.get("priors")),
                    None if cutoff is None else _positive(path, "filtered_at_hz", cutoff,
-                                                         lines.get("filtered_at_hz")))
+                                                         lines.get("filtered_at_hz")),
+                   friction_on)
 
 
 @dataclass(frozen=True)
