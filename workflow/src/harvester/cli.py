@@ -44,8 +44,9 @@ recording: a CSV file, comma-separated, '.' as the decimal point, with a header:
   (other columns are carried along unused).
 sidecar RECORDING.yaml beside it (optional): M (kg), m (kg), k (N/m), priors
   ({name: {mean, sd}}), filtered_at_hz (Hz), friction_on (base or ground: what the
-  friction acts on; ground: diagnose rewrites base_disp -> rel_disp as force k y -> x). Device parameters it does not give are
-  identified, or must be given, or assumed with --paper-device (the paper's Table 1:
+  friction acts on; ground: diagnose rewrites base_disp -> rel_disp as force k y -> x).
+  Device parameters it does not give are identified, or must be given, or assumed with
+  --paper-device (the paper's Table 1:
   M 12.8 kg, m 8 kg, k 250 N/m); what was assumed is logged and written to the output.
 exit status: 0 done, 2 bad input (named: file, line or column, found, expected)."""
 

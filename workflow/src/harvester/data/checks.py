@@ -44,7 +44,8 @@ scenarios 0.3-1.0 raise nothing.
 Gravity left in an acceleration and displacements beyond 5 m are
 ``recording.check_plausible``'s (called from here). Checks that rest on linear theory (the
 linear FRF fit's m/M, ``harvester.initial.frf``) ask :func:`nonlinearity` first: on a visibly
-nonlinear recording what they find is a warning with that evidence, not an error. The sidecar (``RECORDING.yaml``) is checked by ``harvester.data.sidecar``.
+nonlinear recording what they find is a warning with that evidence, not an error. The
+sidecar (``RECORDING.yaml``) is checked by ``harvester.data.sidecar``.
 """
 
 from __future__ import annotations
@@ -326,7 +327,8 @@ def gain_above_resonance(df: pd.DataFrame, kinds: RecordingKinds, dt: float,
 
 
 #: The unit slip each input kind is most often recorded with.
-_SLIP_EXAMPLE = {"base_acc": "base_acc in g", "force": "force in kN", "base_disp": "base_disp in mm"}
+_SLIP_EXAMPLE = {"base_acc": "base_acc in g", "force": "force in kN",
+                 "base_disp": "base_disp in mm"}
 
 
 def check_units_by_physics(df: pd.DataFrame, kinds: RecordingKinds, dt: float,

@@ -13,9 +13,9 @@ and what B cannot follow is the evidence A would gain on such a recording,
 
     gap_A(u) = lambda sum_t (y_A(t) - y_B*(t))^2 / (2 sigma^2)      (nats),
 
-(y the output in the recording's kind, z'' or z) through the likelihood's low-pass, over a window as long as the one analysed, lambda and
-sigma the diagnosis's tempering and noise level (an expected log Bayes factor, the parameters'
-Occam factors left out). The experiment whose smaller gap (A true, or B true) is largest is
+(y the output in the recording's kind, z'' or z) through the likelihood's low-pass, over a
+window as long as the one analysed, lambda and sigma the diagnosis's tempering and noise level
+(an expected log Bayes factor, the parameters' Occam factors left out). The experiment whose smaller gap (A true, or B true) is largest is
 the one recommended.
 """
 
