@@ -18,7 +18,11 @@ rel_disp   m      rel_disp           simulated z, standstill where |z'| stays sm
 
 Input kinds the model cannot take as they are (``base_disp``) are converted to one it can
 by :func:`model_recording`; the recording passed in is never changed (a converted copy is
-returned, the conversion stated in its notes).
+returned, the conversion stated in its notes). :func:`paper_case` reads any recording as the
+paper's base_acc -> rel_acc case for the methods written for it (the FRF damping fit of the
+priors); :func:`on_ground` rewrites a base_disp -> rel_disp recording of a device whose
+friction acts on the mass's own velocity (the sidecar's ``friction_on: ground``) in absolute
+coordinates.
 
 A displacement is differentiated in the frequency domain: the line joining its end points is
 removed (a straight line has no acceleration), the record is extended by its odd reflection at
@@ -42,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
+from scipy import signal
 
 from harvester.data.signals import butterworth_sos, chain_cutoff
 
@@ -75,7 +80,6 @@ def derivative(x: ArrayLike, dt: float, order: int, cutoff_hz: float | None,
         ext = np.concatenate([r[pad:0:-1], r, r[-2:-pad - 2:-1]])
     f = np.fft.rfftfreq(ext.size, dt)
     sos = butterworth_sos(fs, cutoff, filter_order)
-    from scipy import signal
     gain = np.abs(signal.sosfreqz(sos, worN=f, fs=fs)[1]) ** 2
     with np.errstate(divide="ignore", invalid="ignore"):
         factor = np.where(f >= low_hz, (2j * np.pi * np.maximum(f, 1e-300)) ** order, 0.0) \
@@ -284,7 +288,6 @@ def _amplified_noise(x: np.ndarray, dt: float, cutoff: float, kind: InputKind,
     recorded without a known low-pass holds most of its power near the DAQ's edge: the sensor's
     noise, amplified by (2 pi f)^2."""
     import logging
-    from scipy import signal
     f, p = signal.welch(x, fs=1.0 / dt, nperseg=min(x.size, int(round(2.0 / dt))))
     edge = NOISE_BAND_FRACTION * cutoff
     share = float(np.sum(p[f > edge]) / max(np.sum(p), 1e-300))
