@@ -244,3 +244,18 @@ def test_friction_on_the_ground_from_the_sidecar(tmp_path) -> None:
     (tmp_path / "r.yaml").write_text("k: 1000\nfriction_on: storey\n")
     with pytest.raises(DataError, match="line 2.*'friction_on' must be base or ground"):
         read_sidecar(tmp_path / "r.csv")
+
+
+def test_every_fitting_command_reads_a_ground_device_alike(tmp_path) -> None:
+    """The command line's reader rewrites a friction_on: ground recording for identify,
+    compare, predict and diagnose (not for check, which shows the file as it is)."""
+    from harvester.cli import _read
+    from harvester.data.daq import write_recording
+    rec = tmp_path / "rec.csv"
+    write_recording(displacement_recording(), rec)
+    (tmp_path / "rec.yaml").write_text("M: 12.8\nm: 12.8\nk: 250.0\nfriction_on: ground\n")
+    checked, kp = _read(rec, False, for_model=True)
+    assert (checked.kinds.input_kind, checked.kinds.output_kind) == ("force", "rel_disp")
+    assert "m" not in kp.values and kp.values["k"] == 250.0
+    checked, kp = _read(rec, False)
+    assert checked.kinds.input_kind == "base_disp" and kp.values["m"] == 12.8

@@ -263,8 +263,12 @@ def _warn(text: str) -> None:
         print(f"harvester: warning: {text}", file=sys.stderr)
 
 
-def _read(path: Path, paper_device: bool, accept=None, known=None, known_from=None):
-    """(checked recording, known parameters); the checks' warnings reported."""
+def _read(path: Path, paper_device: bool, accept=None, known=None, known_from=None,
+          for_model: bool = False):
+    """(checked recording, known parameters); the checks' warnings reported. ``for_model``:
+    a device whose sidecar says ``friction_on: ground`` is rewritten in absolute coordinates
+    (``harvester.data.kinds.on_ground``) after the checks, so that every command that fits or
+    predicts sees the same form."""
     from harvester.data.daq import read_checked_recording
     from harvester.data.sidecar import read_sidecar, resolve_known
     from harvester.study.paper import TABLE1_KNOWN
@@ -277,6 +281,17 @@ def _read(path: Path, paper_device: bool, accept=None, known=None, known_from=No
         _warn(str(w))
     for note in kp.notes(sidecar):
         (_warn if note.startswith("ASSUMED") else log.info)(note)
+    if for_model and sidecar.friction_on == "ground":
+        from dataclasses import replace
+
+        from harvester.data.kinds import on_ground
+        from harvester.data.recording import recording_kinds
+        df, values, done = on_ground(checked.data, values, str(path))
+        for line in done:
+            log.info("%s", line)
+        checked = replace(checked, data=df, kinds=recording_kinds(df, path))
+        kp = replace(kp, values={k: v for k, v in kp.values.items() if k != "m"},
+                     given={k: v for k, v in kp.given.items() if k != "m"})
     return checked, kp
 
 
@@ -386,7 +401,7 @@ def identify_command(args: argparse.Namespace) -> int:
     from harvester.inference.recording_fit import fit_recording
     check_output_dir(args.out, inputs=(args.recording,))
     settings = _settings(args)
-    checked, kp = _read(args.recording, args.paper_device)
+    checked, kp = _read(args.recording, args.paper_device, for_model=True)
     problem, priors, notes = _prepare_fit(args, args.model, checked, kp)
     record = {**_record("identify", args, checked, kp),
               **_fit_record(problem, priors, notes, settings)}
@@ -411,7 +426,7 @@ def compare_command(args: argparse.Namespace) -> int:
     if len(set(args.models)) != len(args.models):
         raise DataError("<command line>", f"--models repeats a model: {args.models}")
     settings = _settings(args)
-    checked, kp = _read(args.recording, args.paper_device)
+    checked, kp = _read(args.recording, args.paper_device, for_model=True)
     prepared = {m: _prepare_fit(args, m, checked, kp) for m in args.models}
     record = _record("compare", args, checked, kp)
     with atomic_directory(args.out, _key(args)) as stage:
@@ -446,7 +461,7 @@ def predict_command(args: argparse.Namespace) -> int:
         raise DataError(args.posterior, f"cannot read as netCDF: {err}") from None
     _quiet_pymc()
     _, known = posterior_structure(idata, str(args.posterior))
-    checked, kp = _read(args.recording, False, known=known,
+    checked, kp = _read(args.recording, False, for_model=True, known=known,
                         known_from=f"the posterior {args.posterior.name}")
     for name, value in kp.given.items():
         if name in known and abs(known[name] - value) > 1e-9 * abs(value):
@@ -485,7 +500,7 @@ def _diagnosis_inputs(args: argparse.Namespace):
     from harvester.data.signals import filter_recording
     accept = Accepted(tuple(INPUTS), tuple(OUTPUTS), "harvester diagnose",
                       "time, one input and one output column")  # every kind
-    checked, kp = _read(args.recording, args.paper_device, accept)
+    checked, kp = _read(args.recording, args.paper_device, accept, for_model=True)
     if not input_kind(checked.kinds.input_kind).force_input and \
             not {"M", "m", "k"} & set(kp.values):  # eq. (1) cannot fix the scale
         kp.require(("M", "m", "k"), DIAGNOSE_NEEDS, checked.sidecar)
@@ -493,7 +508,8 @@ def _diagnosis_inputs(args: argparse.Namespace):
     notes = [str(w) for w in checked.warnings] + kp.notes(checked.sidecar)
     validation = None
     if args.validation is not None:
-        vc, _ = _read(args.validation, args.paper_device, accept, kp.values, kp.source)
+        vc, _ = _read(args.validation, args.paper_device, accept, kp.values, kp.source,
+                      for_model=True)
         validation = vc.data
         notes += [str(w) for w in vc.warnings]
     if args.lowpass is not None:
@@ -506,16 +522,11 @@ def _diagnosis_inputs(args: argparse.Namespace):
             validation = filter_recording(validation, args.lowpass, args.filter_order,
                                           str(args.validation), output)
         lowpass = args.lowpass
-    known = kp.values
-    if checked.sidecar.friction_on == "ground":  # the device's friction acts on x'
-        from harvester.data.kinds import on_ground
-        df, known, done = on_ground(df, kp.values, str(args.recording))
-        if validation is not None:
-            validation, _, _ = on_ground(validation, kp.values, str(args.validation))
-        for line in done:
-            log.info("%s", line)
-        notes += done
-    return df, validation, lowpass, known, checked.sidecar, notes
+    if checked.sidecar.friction_on == "ground":  # rewritten by _read
+        notes.append(f"{args.recording}: friction on the ground (sidecar friction_on): "
+                     "driven by the force k y with the output x = rel_disp + base_disp "
+                     "(harvester.data.kinds.on_ground)")
+    return df, validation, lowpass, kp.values, checked.sidecar, notes
 
 
 def diagnose_command(args: argparse.Namespace) -> int:
