@@ -221,8 +221,9 @@ def _named(found: Conclusion, missing: MissingForce | None) -> str:
     out = []
     for effects in groups:
         s = next((sizes[e] for e in effects if e in sizes), None)
+        whose = f"{s.term} " if s is not None and len(effects) > 1 else ""
         out.append(" / ".join(effects) + ("" if s is None else
-                   f" ({s.term} {s.force_rms_N:.3g} N RMS, {s.share_of_drive:.2%} of the "
+                   f" ({whose}{s.force_rms_N:.3g} N RMS, {s.share_of_drive:.2%} of the "
                    f"drive, {s.label})"))
     return ", ".join(out)
 
