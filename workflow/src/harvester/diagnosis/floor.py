@@ -159,7 +159,9 @@ def output_floor(u: np.ndarray, y_recorded: np.ndarray, y_chain: np.ndarray,
                  window: tuple[int, int], fs: float, band_hz: float) -> Floor | None:
     """The first floor the recording allows (module docstring): input ``u`` and recorded
     output ``y_recorded`` as recorded, ``y_chain`` the output through the measurement chain,
-    ``window`` the analysed samples, ``band_hz`` the chain's band."""
+    ``window`` the analysed samples, ``band_hz`` the chain's band. Repeated periods are
+    sought over the whole record given (the floor owes nothing to the model, so the lead-in
+    counts too: a window of 2.9 periods of the Silverbox's multisine holds too few)."""
     a, b = window
-    return (periodic_floor(u[a:b], y_chain[a:b], fs) or quiet_floor(u, y_chain, fs)
+    return (periodic_floor(u, y_chain, fs) or quiet_floor(u, y_chain, fs)
             or white_floor(y_recorded[a:b], fs, band_hz))

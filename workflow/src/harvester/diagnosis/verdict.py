@@ -215,17 +215,18 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
 
 
 def _named(found: Conclusion, missing: MissingForce | None) -> str:
-    """The effects named and tied, each with its size where the missing force gave it."""
-    sizes = {s.term: s for s in (missing.sizes if missing is not None else [])}
-    groups = [[e] for e in found.missing] + [t.effects for t in found.ties]
-    out = []
-    for effects in groups:
-        s = next((sizes[e] for e in effects if e in sizes), None)
-        whose = f"{s.term} " if s is not None and len(effects) > 1 else ""
-        out.append(" / ".join(effects) + ("" if s is None else
-                   f" ({whose}{s.force_rms_N:.3g} N RMS, {s.share_of_drive:.2%} of the "
-                   f"drive, {s.label})"))
-    return ", ".join(out)
+    """The effects named and tied, with their size where the missing force gave it. The size
+    is the improved model's force beyond the baseline's (``latent_views.effect_force``): with
+    several effects added it is theirs together, and said once."""
+    groups = [" / ".join(g) for g in [[e] for e in found.missing] + [t.effects
+                                                                       for t in found.ties]]
+    sizes = missing.sizes if missing is not None else []
+    if not sizes:
+        return ", ".join(groups)
+    s = sizes[0]
+    together = "together " if len(sizes) > 1 else ""
+    return (", ".join(groups) + f" ({together}{s.force_rms_N:.3g} N RMS, "
+            f"{s.share_of_drive:.2%} of the drive, {s.label})")
 
 
 def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
