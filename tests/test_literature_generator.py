@@ -374,3 +374,86 @@ def test_a_40_s_record_generates_in_seconds():
     g = L.generate("lugre", 0)
     assert len(g.recording) == 40 * 256
     assert time.perf_counter() - start < 30.0
+
+
+# --------------------------------------------------------------------------- forms outside the library
+
+OUTSIDE = ("cogging", "quadratic_spring", "friction_drift", "mains_hum")
+
+
+def test_forms_outside_the_library_have_no_correct_name_and_a_citation():
+    for name in OUTSIDE:
+        scen = L.SCENARIOS[name]
+        assert scen.correct_names == () and scen.citation and scen.shapes, name
+    # appended after the effect-free scenario: the grid's earlier scenarios keep their places
+    assert list(L.SCENARIOS)[-len(OUTSIDE) - 1:] == ["none", *OUTSIDE]
+
+
+def _shape_and_effect(name, strength, seed=0):
+    _, _, ctx = _setup()
+    scen = L.SCENARIOS[name]
+    shape = scen.draw_shape(np.random.default_rng(seed), ctx)
+    return ctx, shape, L.effect_params(DEVICE, scen.effect(ctx, shape, strength))
+
+
+def test_cogging_is_periodic_in_z_with_its_drawn_period():
+    for seed in range(5):
+        ctx, shape, (kind, p) = _shape_and_effect("cogging", 0.1, seed)
+        period = p[L.E + 1]
+        assert 2.0 <= 4.0 * ctx.z_rms / period <= 6.0  # 2-6 periods over +-2 z_rms
+        z = np.linspace(-2 * ctx.z_rms, 2 * ctx.z_rms, 41)
+        force = np.array([L._extra_force(kind, p, x, 0.3, 0.0) for x in z])
+        shifted = np.array([L._extra_force(kind, p, x + period, -0.1, 0.0) for x in z])
+        amplitude = 0.1 * DEVICE.m * DEVICE.peak_base_acc
+        np.testing.assert_allclose(force, amplitude * np.sin(2 * np.pi * z / period
+                                                             + shape["phase_rad"]), atol=1e-12)
+        np.testing.assert_allclose(shifted, force, atol=1e-9 * amplitude)
+
+
+def test_quadratic_spring_is_even_in_z():
+    ctx, shape, (kind, p) = _shape_and_effect("quadratic_spring", 0.2)
+    k2 = shape["sign"] * 0.2 * DEVICE.k / ctx.z_max
+    for z in (1e-4, 3e-3, ctx.z_max):
+        assert L._extra_force(kind, p, z, 0.1, 0.0) == pytest.approx(k2 * z * z, rel=1e-12)
+        assert L._extra_force(kind, p, -z, -0.2, 0.0) == L._extra_force(kind, p, z, 0.1, 0.0)
+
+
+def test_friction_drift_changes_the_level_linearly_over_the_record():
+    """The friction's level is F_c (1 + sign s (t - T/2) / T): its ratio to the device's
+    friction at equal velocity is that line; the state x[4] runs as the time."""
+    ctx, shape, (kind, p) = _shape_and_effect("friction_drift", 0.6)
+    T = ctx.record_s
+    assert T == pytest.approx(2.0 - 1 / FS)
+    rest = np.zeros(5)
+    for t in (0.0, 0.5 * T, T):
+        x = np.array([0.0, 0.02, 0.0, 0.0, t])
+        viscous = -DEVICE.c * x[1]  # the other forces at z = 0, y'' = 0
+        drifted = viscous - L._rhs(kind, p, x, 0.0, rest) * DEVICE.M
+        assert rest[4] == 1.0
+        plain = viscous - L._rhs(L.NONE, DEVICE.params(), x, 0.0, rest) * DEVICE.M
+        assert drifted / plain == pytest.approx(1 + shape["sign"] * 0.6 * (t / T - 0.5))
+    assert p[L._VREF] == 0.0  # x[4] starts at t = 0
+
+
+def test_mains_hum_is_a_line_on_the_mass_channel_only():
+    g = L.generate("mains_hum", 3, ratio=1.0, duration_s=6.0)
+    par = g.truth["effect"]["parameters"]
+    assert par["frequency_hz"] in L.MAINS_HZ
+    t = g.recording["time"].to_numpy()
+    line = par["amplitude_m_per_s2"] * np.sin(2 * np.pi * par["frequency_hz"] * t
+                                               + par["phase_rad"])
+    win = slice(256, None)
+    np.testing.assert_allclose(g.contribution[win], line[win], atol=1e-4 * NOISE)
+    # the amplitude is the ratio's: RMS A / sqrt(2) = ratio x noise RMS
+    assert par["amplitude_m_per_s2"] / np.sqrt(2) == pytest.approx(
+        g.truth["noise_rms_rel_acc"], rel=0.01)
+
+
+@pytest.mark.parametrize("name", OUTSIDE)
+def test_forms_outside_the_library_reach_their_ratio(name):
+    g = L.generate(name, 11, ratio=1.0, duration_s=8.0)
+    achieved = L._rms(g.contribution[256:]) / g.truth["noise_rms_rel_acc"]
+    assert achieved == pytest.approx(1.0, rel=L.CALIBRATION_RTOL)
+    assert g.truth["correct_names"] == []
+    assert g.truth["integration"]["step_halving_change_to_noise"] <= L.CONVERGENCE_TOL
+    json.dumps(g.truth)

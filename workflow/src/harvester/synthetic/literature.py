@@ -38,7 +38,17 @@ rotor_inertia_error     true M = sidecar's + s M, m right           inertia_erro
 quadratic_damping       c2 v|v|                                     quadratic_damping
 power_damping           c_a |v|^a sgn v, a 1.3-3                    quadratic_damping
 none                    the device only (false-alarm check)         --
+cogging                 A sin(2 pi z / P + phi), P 0.67-2 z_rms     -- (none)
+quadratic_spring        k2 z^2 (a spring stiffer on one side)       -- (offset_force)
+friction_drift          F_dev (1 + s (t - T/2) / T), T the record   -- (none)
+mains_hum               rel_acc + A sin(2 pi 50|60 Hz t + phi)      -- (unmodelled_mode)
 ======================  ==========================================  =========================
+
+The last four are outside the library (no correct name): a force periodic in the
+displacement (a generator's cogging through the screw), an even spring, a slow change (the
+friction's level drifting; a slow force itself would not show in z'', whose response to it
+falls as (f / f_n)^2), and the acquisition's own line (mains hum on the mass accelerometer's
+channel, added to the reading before the DAQ's filter, not to the motion).
 
 Naming: ``correct_names`` are the library terms that name the mechanism; ``related_names``
 describe part of its signature but another physical cause, and are not counted. A memory law's
@@ -129,7 +139,8 @@ _M, _MOSC, _K, _C, _FC, _VT, _FORM, _VREF, E = range(9)
 N_PARAMS = E + 8
 # Effect kinds of the compiled right-hand side.
 (NONE, LUGRE, DAHL, BOUC_WEN, KARNOPP, STRIBECK, ASYMMETRIC, STOP_KV, STOP_POWER,
- SPRING_POWER, DAMP_POWER, MOUNT, SECONDARY) = range(13)
+ SPRING_POWER, DAMP_POWER, MOUNT, SECONDARY, PERIODIC_Z, SPRING_EVEN, FRICTION_DRIFT,
+ SENSOR_LINE) = range(17)
 
 
 # --------------------------------------------------------------------------- compiled physics
@@ -194,6 +205,10 @@ def _extra_force(kind, p, z, v, v_impact):
         return p[E] * abs(z) ** p[E + 1] * np.sign(z)
     if kind == DAMP_POWER:
         return p[E] * abs(v) ** p[E + 1] * np.sign(v)
+    if kind == PERIODIC_Z:
+        return p[E] * np.sin(2.0 * np.pi * z / p[E + 1] + p[E + 2])
+    if kind == SPRING_EVEN:
+        return p[E] * z * z
     return 0.0
 
 
@@ -233,7 +248,8 @@ def _rhs(kind, p, x, yb, dx):
     """d(state)/dt into dx for base acceleration yb (m/s^2); returns z'' (m/s^2).
 
     State: z, z', then the effect's: memory variable (kept by :func:`_relax`), or the second
-    body's displacement and velocity; x[4] holds the last impact velocity of a stop.
+    body's displacement and velocity; x[4] holds the last impact velocity of a stop, or the
+    time for a drifting friction (started at p[_VREF] = 0).
     """
     if kind == MOUNT:
         return _rhs_mount(p, x, yb, dx)
@@ -241,9 +257,13 @@ def _rhs(kind, p, x, yb, dx):
         return _rhs_secondary(p, x, yb, dx)
     z, v = x[0], x[1]
     rest = -p[_MOSC] * yb - p[_C] * v - p[_K] * z - _extra_force(kind, p, z, v, x[4])
-    acc = (rest - _friction(kind, p, v, x[2], rest)) / p[_M]
+    if kind == FRICTION_DRIFT:  # x[4] holds the time (s)
+        acc = (rest - _kinetic(p, v) * (1.0 + p[E] * (x[4] - p[E + 1]) / p[E + 2])) / p[_M]
+    else:
+        acc = (rest - _friction(kind, p, v, x[2], rest)) / p[_M]
     dx[0], dx[1] = v, acc
-    dx[2] = dx[3] = dx[4] = 0.0
+    dx[2] = dx[3] = 0.0
+    dx[4] = 1.0 if kind == FRICTION_DRIFT else 0.0
     return acc
 
 
@@ -575,7 +595,8 @@ class TimeBase:
 
 def simulate(kind: int, p: np.ndarray, y2: np.ndarray, tb: TimeBase,
              n_sub: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """z'' (m/s^2), z (m), z' (m/s) at the internal rate, from rest.
+    """z'' (m/s^2), z (m), z' (m/s) at the internal rate, from rest (for SENSOR_LINE, z'' as
+    the mass accelerometer reads it: the motion's plus its hum).
 
     ``y2``: the base acceleration at two samples per internal step, ``excitation.on_grid(2 /
     h_int)``. Raises FloatingPointError if the motion is not finite.
@@ -585,6 +606,9 @@ def simulate(kind: int, p: np.ndarray, y2: np.ndarray, tb: TimeBase,
     acc, z, v = _integrate(int(kind), np.ascontiguousarray(p, dtype=float), y2, tb.n_int,
                            int(n_sub), tb.h_int, lagrange_weights(int(n_sub)),
                            lagrange_weights(int(n_sub) * SWITCH_REFINE), SWITCH_REFINE)
+    if kind == SENSOR_LINE:  # the mass accelerometer's reading: a hum on top of the motion
+        acc = acc + p[E] * np.sin(2.0 * np.pi * p[E + 1] * tb.h_int * np.arange(acc.size)
+                                  + p[E + 2])
     if not np.all(np.isfinite(acc)):
         raise FloatingPointError(f"effect kind {kind}: the motion diverged (n_sub = {n_sub})")
     return acc, z, v
@@ -633,13 +657,16 @@ class Context:
     v_rms: float          # RMS relative velocity after the lead-in (m/s)
     z_max: float          # largest |z| (m) over the simulated span
     abs_z: np.ndarray = field(repr=False)  # sorted |z| (m) over the simulated span
+    record_s: float = 0.0  # time (s) of the record's last output sample
 
     @classmethod
     def of(cls, device: Device, fs: float, z: np.ndarray, v: np.ndarray,
            window: slice) -> Context:
-        """From the baseline's internal-rate z, z' and the internal window after the lead-in."""
+        """From the baseline's internal-rate z, z' and the internal window after the lead-in
+        (which ends at the record's last output sample)."""
         abs_z = np.sort(np.abs(z))
-        return cls(device, fs, _rms(z[window]), _rms(v[window]), float(abs_z[-1]), abs_z)
+        return cls(device, fs, _rms(z[window]), _rms(v[window]), float(abs_z[-1]), abs_z,
+                   (window.stop - 1) / (OVERSAMPLE * fs))
 
     def gap(self, quantile: float) -> float:
         """The |z| quantile (m) of the baseline motion (1: its largest |z|, never exceeded)."""
@@ -801,6 +828,25 @@ _CITE = {
             "modelling of a rotational energy harvester. J. Intell. Mater. Syst. Struct. "
             "27(4):528-536, eq. (1): M = m + rotor inertia reflected through the screw lead.",
     "none": "Green et al. (2015), eq. (1), with the device's own smooth friction law.",
+    "cogging": "Zhu, Z.Q., Howe, D. (2000) Influence of design parameters on cogging torque in "
+               "permanent magnet machines. IEEE Trans. Energy Convers. 15(4):407-412; Bianchi, "
+               "N., Bolognani, S. (2002) Design techniques for reducing the cogging torque in "
+               "surface-mounted PM motors. IEEE Trans. Ind. Appl. 38(5):1259-1265 (the "
+               "harvester's generator, reflected through the screw lead as in Green et al. "
+               "2015).",
+    "quadratic_spring": "Worden, K., Tomlinson, G.R. (2001) Nonlinearity in Structural "
+                        "Dynamics. IOP (asymmetric, even restoring forces); Nayfeh, A.H., "
+                        "Mook, D.T. (1979) Nonlinear Oscillations. Wiley (quadratic "
+                        "nonlinearity).",
+    "friction_drift": "Bittencourt, A.C., Gunnarsson, S. (2012) Static friction in a robot "
+                      "joint - modeling and identification of load and temperature effects. "
+                      "ASME J. Dyn. Syst. Meas. Control 134(5):051013; Armstrong-Helouvry et "
+                      "al. (1994), Automatica 30(7) (friction's dependence on temperature and "
+                      "time).",
+    "mains_hum": "Bendat, J.S., Piersol, A.G. (2010) Random Data: Analysis and Measurement "
+                 "Procedures, 4th ed. Wiley (periodic contamination of measured data, power-"
+                 "line pickup); Ewins, D.J. (2000) Modal Testing, 2nd ed. (mains hum in "
+                 "transducer signals).",
 }
 
 
@@ -967,14 +1013,76 @@ def _damping() -> list[LiteratureScenario]:
     ]
 
 
+#: Mains frequencies (Hz) a hum may have.
+MAINS_HZ = (50.0, 60.0)
+
+
+def _mains(rng: np.random.Generator, ctx: Context) -> dict:
+    """50 or 60 Hz (even odds, among those <= 0.35 fs, inside the DAQ's flat band), a phase."""
+    usable = [f for f in MAINS_HZ if f <= 0.35 * ctx.fs]
+    if not usable:
+        raise ValueError(f"mains_hum needs fs >= {MAINS_HZ[0] / 0.35:.0f} Hz")
+    return {"frequency_hz": float(rng.choice(usable)),
+            "phase_rad": rng.uniform(0.0, 2.0 * np.pi)}
+
+
+def _cogging(ctx: Context, sh: dict, s: float) -> Effect:
+    """A sin(2 pi z / P + phi): A = s m max|y''|, P = 4 z_rms / (periods over +-2 z_rms)."""
+    d = ctx.device
+    return (PERIODIC_Z, [s * d.m * d.peak_base_acc, 4.0 * ctx.z_rms / sh["periods"],
+                         sh["phase_rad"]], {})
+
+
+def _friction_drift(ctx: Context, sh: dict, s: float) -> Effect:
+    """F_c (1 + sign s (t - T/2) / T) over the record's span T; x[4] runs as the time."""
+    return (FRICTION_DRIFT, [sh["sign"] * s, 0.5 * ctx.record_s, ctx.record_s],
+            {"v_ref": 0.0})
+
+
+def _outside_library() -> list[LiteratureScenario]:
+    """Forms no library term names (correct names empty): a force periodic in z, an even
+    spring, a slow change of the friction, and a line the acquisition adds."""
+    S = LiteratureScenario
+    return [
+        S("cogging", "force periodic in z", "F = A sin(2 pi z / P + phi)", (), (),
+          "the generator's cogging torque (a detent per magnet pitch) through the screw lead: "
+          "a force periodic in the displacement", _CITE["cogging"],
+          "A / (m max|y''|), 1e-6..1",
+          "P = 4 z_rms / n, n 2-6 periods over +-2 z_rms (uniform); phi 0-2 pi",
+          lambda rng, ctx: {"periods": rng.uniform(2.0, 6.0),
+                            "phase_rad": rng.uniform(0.0, 2.0 * np.pi)},
+          lambda ctx, sh: (1e-6, 1.0), _cogging),
+        S("quadratic_spring", "asymmetric spring", "F = k2 z^2, k2 = sign kappa k / z_max",
+          (), ("offset_force",), "a spring stiffer on one side than the other (a quadratic, "
+          "even-in-z restoring force)", _CITE["quadratic_spring"],
+          "kappa (added stiffness at z_max / k), 1e-6..0.3 (the second equilibrium beyond "
+          "3 z_max)", "sign +-1 (even odds)", _sign, lambda ctx, sh: (1e-6, 0.3),
+          lambda ctx, sh, kappa: (SPRING_EVEN, [sh["sign"] * kappa * ctx.device.k
+                                                / ctx.z_max], {})),
+        S("friction_drift", "slow change", "F = F_c S(v/v_t) (1 + sign s (t - T/2) / T), T "
+          "the record's span", (), (), "the sliding friction's level drifts linearly in time "
+          "(the lubricant warming or cooling)", _CITE["friction_drift"],
+          "s (the level's change over the record / F_c), 1e-5..1.5", "sign +-1 (even odds)",
+          _sign, lambda ctx, sh: (1e-5, 1.5), _friction_drift),
+        S("mains_hum", "acquisition", "rel_acc += A sin(2 pi f_mains t + phi) (the mass "
+          "accelerometer's channel only)", (), ("unmodelled_mode",),
+          "mains hum picked up by one accelerometer's cable (a ground loop): a line at a fixed "
+          "frequency, not a force", _CITE["mains_hum"], "A (m/s^2), 1e-9..1e3",
+          "f_mains 50 or 60 Hz (even odds, <= 0.35 fs); phi 0-2 pi", _mains,
+          lambda ctx, sh: (1e-9, 1e3),
+          lambda ctx, sh, a: (SENSOR_LINE, [a, sh["frequency_hz"], sh["phase_rad"]], {})),
+    ]
+
+
 def _scenarios() -> dict[str, LiteratureScenario]:
-    """The registry, in the order of the module docstring's table."""
+    """The registry, in the order of the module docstring's table (the forms outside the
+    library after the effect-free one)."""
     none = LiteratureScenario(
         "none", "effect-free", "the baseline device only", (), (),
         "no concealed effect (false-alarm check)", _CITE["none"], "none", "none",
         lambda rng, ctx: {}, lambda ctx, sh: (0.0, 0.0), lambda ctx, sh, s: (NONE, [], {}))
     entries = (_friction_scenarios() + _stop_scenarios() + _spring_scenarios()
-               + _structural_and_mass() + _damping() + [none])
+               + _structural_and_mass() + _damping() + [none] + _outside_library())
     return {e.name: e for e in entries}
 
 
@@ -986,7 +1094,8 @@ SCENARIOS: dict[str, LiteratureScenario] = _scenarios()
 
 _KIND_NAMES = ("none", "lugre", "dahl", "bouc_wen", "karnopp", "stribeck", "asymmetric",
                "stop_kelvin_voigt", "stop_power", "spring_power", "damper_power", "mount",
-               "secondary_mode")
+               "secondary_mode", "periodic_in_z", "spring_even", "friction_drift",
+               "sensor_line")
 #: Names of the effect parameters p[E:] per kind (SI units).
 EFFECT_PARAMETERS: dict[int, tuple[str, ...]] = {
     NONE: (), LUGRE: ("share", "sigma0_N_per_m", "sigma1_N_s_per_m"),
@@ -1000,6 +1109,9 @@ EFFECT_PARAMETERS: dict[int, tuple[str, ...]] = {
     SPRING_POWER: ("k_p_N_per_m^p", "p"), DAMP_POWER: ("c_a_N_(s/m)^a", "a"),
     MOUNT: ("m_b_kg", "k_b_N_per_m", "c_b_N_s_per_m"),
     SECONDARY: ("m2_kg", "k2_N_per_m", "c2_N_s_per_m"),
+    PERIODIC_Z: ("amplitude_N", "period_m", "phase_rad"), SPRING_EVEN: ("k2_N_per_m2",),
+    FRICTION_DRIFT: ("change_over_record", "t_centre_s", "record_s"),
+    SENSOR_LINE: ("amplitude_m_per_s2", "frequency_hz", "phase_rad"),
 }
 
 
