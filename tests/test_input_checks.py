@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import functools
 import logging
+import re
 import time
 
 import numpy as np
@@ -108,6 +109,30 @@ def _disp(f, sidecar=SIDECAR):
     return lambda df, tmp: (_text(f(displacement_recording().copy()), tmp), sidecar)
 
 
+@functools.lru_cache(maxsize=1)
+def acceleration_displacement_recording() -> pd.DataFrame:
+    """:func:`displacement_recording` as base_acc -> rel_disp: its base displacement
+    differentiated twice (``harvester.data.kinds.model_recording``), the output in m."""
+    from harvester.data.kinds import model_recording
+    return model_recording(displacement_recording(), None)[0]
+
+
+def _acc_disp(f, sidecar=SIDECAR):
+    return lambda df, tmp: (_text(f(acceleration_displacement_recording().copy()), tmp),
+                            sidecar)
+
+
+def _random_walk(d: pd.DataFrame) -> pd.DataFrame:
+    """A sensor wandering as a random walk of 0.2 mm steps (4.6 mm RMS over 8 s)."""
+    walk = 2e-4 * np.cumsum(np.random.default_rng(7).standard_normal(len(d)))
+    return d.assign(base_disp=d.base_disp + walk)
+
+
+def _warming_up(d: pd.DataFrame) -> pd.DataFrame:
+    """A sensor warming up: 1 cm approached with a 2 s time constant (a curved drift)."""
+    return d.assign(base_disp=d.base_disp + 0.01 * (1.0 - np.exp(-d.time / 2.0)))
+
+
 def _semicolons(text: str, decimal_comma: bool) -> str:
     rows = [line.split(",") for line in text.splitlines()]
     if decimal_comma:
@@ -192,6 +217,13 @@ CASES = [
              "probably mm"]),
     ("base_disp_in_mm", _disp(lambda d: d.assign(base_disp=d.base_disp * 1000.0)),
      "diagnose", ERROR, ["column 'base_disp'", "more than 5 m", "probably mm"]),
+    ("rel_disp_in_mm_base_acc_in_m_s2", _acc_disp(lambda d: d.assign(rel_disp=d.rel_disp * 1e3)),
+     "diagnose", ERROR, ["column 'rel_disp'", "moves at 17.2 m/s RMS", "probably mm",
+                         "in m it would move at 0.0172 m/s", "rel_disp must be in m"]),
+    ("base_disp_in_mm_below_5", _disp(lambda d: d.assign(base_disp=d.base_disp * 50.0,
+                                                         rel_disp=d.rel_disp * 0.05)),
+     "diagnose", ERROR, ["column 'base_disp'", "moves at 5.58 m/s RMS", "probably mm",
+                         "base_disp must be in m"]),
     ("rel_disp_unit_in_header", _disp(lambda d: d.rename(columns={"rel_disp": "rel_disp_mm"})),
      "diagnose", ERROR, ["line 1", "column 'rel_disp_mm'", "in mm", "'rel_disp' in m"]),
     ("no_sidecar", _txt(lambda t: t, None), "diagnose", ERROR,
@@ -216,7 +248,11 @@ CASES = [
     ("paper_device_assumed", _txt(lambda t: t, None), "check --paper-device", OK,
      ["ASSUMED (not measured)", "M = 12.8 kg", "the paper's Table 1 (--paper-device)"]),
     ("force_valid", _force(lambda d: d), "check", OK, ["0 warning(s)"]),
+    ("force_in_mN", _force(lambda d: d.assign(force=d.force * 1000.0)), "check", OK,
+     ["median |rel_acc / force| is 4.274e-05", "0.000547 times the most a passive device",
+      "1/M = 0.07812, from the sidecar", "factor 1000", "a unit slip (force in mN"]),
     ("displacements_valid", _disp(lambda d: d), "check", OK, ["0 warning(s)"]),
+    ("acceleration_displacement_valid", _acc_disp(lambda d: d), "check", OK, ["0 warning(s)"]),
     ("fast_displacements_no_masses", _disp(lambda d: d.assign(base_disp=d.base_disp * 100.0,
                                                                rel_disp=d.rel_disp * 100.0),
                                             None),
@@ -225,6 +261,12 @@ CASES = [
     ("drifting_base", _disp(lambda d: d.assign(base_disp=d.base_disp + 0.004 * d.time)),
      "check", OK, ["column 'base_disp'", "drifts by 0.03", "m over 8 s", "RMS oscillation",
                    "drifting sensor"]),
+    ("drifting_base_random_walk", _disp(_random_walk), "check", OK,
+     ["column 'base_disp'", "drifts by -0.01249 m over 8 s", "0.98 times its RMS oscillation",
+      "more than 0.5 is reported", "drifting sensor"]),
+    ("drifting_base_warming_up", _disp(_warming_up), "check", OK,
+     ["column 'base_disp'", "drifts by 0.007361 m over 8 s", "0.62 times its RMS oscillation",
+      "a laser or LVDT warming up", "a curved one adds a slow acceleration"]),
 ]
 
 
@@ -268,7 +310,9 @@ def test_the_matrix_covers_the_issue():
                  "saturated_30pct", "base_acc_in_g", "cell_1e300", "time_in_ms", "semicolons",
                  "decimal_commas", "no_sidecar",
                  # issue 41: the new kinds
-                 "force_in_kN", "rel_disp_in_mm", "base_disp_in_mm", "drifting_base"):
+                 "force_in_kN", "force_in_mN", "rel_disp_in_mm", "base_disp_in_mm",
+                 "base_disp_in_mm_below_5", "rel_disp_in_mm_base_acc_in_m_s2",
+                 "drifting_base", "drifting_base_random_walk", "drifting_base_warming_up"):
         assert case in ids, case
 
 
@@ -362,6 +406,35 @@ def test_unit_slip_of_a_force_input_needs_the_mass(tmp_path):
     with pytest.raises(DataError, match="1/M = 0.1, from the sidecar.*factor 1000.*force in kN"):
         checks.check_units_by_physics(df.assign(force=df.force / 1000), kinds, 1 / 200.0,
                                       known, "r")
+
+
+#: Said of a slip in one column, x1000: its verdict, gain over the bound, and the slips named.
+_ALLOWS = "times the most a passive device allows"
+SLIP_SAID = [
+    ("base_acc", "rel_disp", "rel_disp",
+     f"error: .* 994 {_ALLOWS}.*e.g. base_acc in g or rel_disp in mm\\)"),
+    ("force", "rel_disp", "force", f"warning: .* 0.000994 {_ALLOWS}.*unit slip \\(force in mN\\)"),
+    ("base_acc", "rel_acc", "base_acc",
+     f"warning: .* 0.000994 {_ALLOWS}.*unit slip \\(base_acc in mm/s\\^2 or rel_acc in g\\)")]
+
+
+@pytest.mark.parametrize("inp, out, column, expected", SLIP_SAID)
+def test_a_unit_slip_names_the_slips_that_move_the_gain_its_way(inp, out, column, expected):
+    """x1000 on one column of a broadband recording of a 10 kg device: the gain 1000 times
+    too high is refused naming the slips that raise it (an output in mm, an input in g or
+    kN), too low is a warning naming those that lower it (a force in mN, a base_acc in
+    mm/s^2, a rel_acc in g)."""
+    from test_recording_kinds import TRUTH, synthetic
+    df = synthetic(inp, out, n=1600, noise=0.01)
+    kinds = RecordingKinds(inp, out)
+    assert checks.check_units_by_physics(df, kinds, 1 / 200.0, TRUTH, "r") == []
+    df[column] *= 1000.0
+    try:
+        said = "warning: " + " ".join(str(w) for w in checks.check_units_by_physics(
+            df, kinds, 1 / 200.0, TRUTH, "r"))
+    except DataError as err:
+        said = f"error: {err}"
+    assert re.search(expected, said), said
 
 
 def test_reader_returns_the_warnings_and_the_sidecar(valid, tmp_path):

@@ -164,13 +164,80 @@ def test_the_frame_with_its_friction_on_the_ground_is_a_force_input() -> None:
         marino_frame(FRAME, 450, friction_on="storey")
 
 
+def _check(rec, tmp_path, capsys, name: str) -> tuple[int, str]:
+    """(exit status, what was said) of ``harvester check`` on ``rec`` written as name.csv
+    with its sidecar: the reader and checks every command runs first."""
+    from harvester.cli import main
+    path = rec.write(tmp_path / f"{name}.csv")
+    code = main(["check", str(path)])
+    std = capsys.readouterr()
+    return code, std.out + std.err
+
+
+@pytest.mark.skipif(not FRAME.is_dir(), reason="no ../shared/data/marino-frame")
+@pytest.mark.parametrize("friction_on", ["base", "ground"])
+def test_the_frame_in_other_units_is_named(tmp_path, capsys, friction_on) -> None:
+    """The frame's recordings (both loads) as converted pass without a warning; a displacement
+    in mm is refused with its column and speed (6.3-10.3 m/s RMS read as m), the ground
+    form's force K y in kN (1.5 mN RMS) refused from its gain below resonance (about 1000
+    times 1 / |k - M w^2|; as recorded 0.80-0.98 times it), in mN a warning."""
+    from dataclasses import replace
+
+    from harvester.data.public import marino_frame
+    for load in (250, 450):
+        rec = marino_frame(FRAME, load, friction_on=friction_on)
+        code, said = _check(rec, tmp_path, capsys, f"{load}")
+        assert code == 0 and "0 warning(s)" in said, said
+        inp = rec.data.columns[1]
+        for col in (inp, "rel_disp") if inp == "base_disp" else ("rel_disp",):
+            bad = replace(rec, data=rec.data.assign(**{col: rec.data[col] * 1000.0}))
+            code, said = _check(bad, tmp_path, capsys, f"{load}_{col}_mm")
+            assert code == 2 and f"_mm.csv, column '{col}': {col} moves at" in said, said
+            speed = float(said.split(" moves at ")[1].split(" m/s RMS")[0])
+            assert 6.0 < speed < 11.0 and "probably mm" in said and f"{col} must be in m" in said
+        if inp != "force":
+            continue
+        kn = replace(rec, data=rec.data.assign(force=rec.data.force / 1000.0))
+        code, said = _check(kn, tmp_path, capsys, f"{load}_kN")
+        assert code == 2 and "_kN.csv: below resonance (0.5-1 Hz" in said, said
+        ratio = float(said.split("|rel_disp / force| is ")[1].split(", ")[1].split(" times")[0])
+        assert 500 < ratio < 1500 and "factor 1000" in said and "force in kN" in said
+        mn = replace(rec, data=rec.data.assign(force=rec.data.force * 1000.0))
+        code, said = _check(mn, tmp_path, capsys, f"{load}_mN")
+        assert code == 0 and "1 warning(s)" in said and "unit slip (force in mN)" in said
+
+
+@pytest.mark.skipif(not FRAME.is_dir(), reason="no ../shared/data/marino-frame")
+def test_the_frame_with_a_drifting_base_laser_is_a_warning(tmp_path, capsys) -> None:
+    """The frame's base laser drifts 0.27 times its oscillation as recorded (nothing said);
+    with 2 mm added over the record, 1.8 times: a warning with the numbers."""
+    from dataclasses import replace
+
+    from harvester.data.public import marino_frame
+    rec = marino_frame(FRAME, 450)
+    d = drift(rec.data.base_disp, 0.004)
+    assert 0.2 < d.share < 0.35 and not d.drifting
+    t = rec.data.time
+    ramp = replace(rec, data=rec.data.assign(base_disp=rec.data.base_disp + 0.002 * t / t.max()))
+    code, said = _check(ramp, tmp_path, capsys, "drift")
+    assert code == 0 and "1 warning(s)" in said, said
+    assert "drift.csv, column 'base_disp': the base displacement drifts by 0.002345 m over 10 s"\
+        in said and "1.8 times its RMS oscillation" in said and "drifting sensor" in said
+
+
 @pytest.mark.skipif(not SILVERBOX.is_file(), reason="no ../shared/data/silverbox")
 def test_the_silverbox_reads_in_volts() -> None:
+    """Read, and checked: its only warning is the displacement's speed read as m (it is in
+    volts; M, m not known, so not refused)."""
     from harvester.data.public import silverbox
     rec = silverbox(SILVERBOX, samples=4096)
     assert list(rec.data.columns) == ["time", "force", "rel_disp"] and len(rec.data) == 4096
     assert rec.sidecar == {} and "VOLTS" in rec.notes[0]
     assert 1.0 / np.mean(np.diff(rec.data.time)) == pytest.approx(610.35, abs=0.01)
+    found = checks.check_recording(rec.data, RecordingKinds("force", "rel_disp"),
+                                   1.0 / 610.3515625, "sb", rec.sidecar)
+    assert [(w.check, w.column) for w in found] == [("unit", "rel_disp")]
+    assert "24.6 m/s RMS" in found[0].message and "a circuit in volts" in found[0].message
 
 
 def test_harvester_diagnose_takes_displacements_end_to_end(tmp_path, capsys) -> None:

@@ -27,19 +27,28 @@ drift                     a base displacement's straight-line change over the   
 fast displacement         a displacement whose derivative moves faster than     error with
                           MAX_VELOCITY_RMS (mm read as m)                       M or m given,
                                                                                 else warning
-unit slip                 the output/input gain above resonance against the     error: median
-                          bound M, m, k allow (m/M for base_acc -> rel_acc):    above
-                          g against m/s^2, mm against m, kN against N           UNIT_RATIO;
-                          (friction lowers the gain, so heavy friction can      warning: 90th
-                          hide a slip; a low gain needs M, m known)             percentile
-                                                                                below 1/(2 it)
+unit slip                 the output/input gain above resonance (a force        error: median
+                          input driven below it: below) against the bound M,    above
+                          m, k allow (m/M for base_acc -> rel_acc): g against   UNIT_RATIO;
+                          m/s^2, mm against m, kN or mN against N (friction     warning: 90th
+                          lowers the gain, so heavy friction can hide a slip;   percentile
+                          a low gain needs M, m known)                          below 1/(2 it)
 ========================= ===================================================== ==========
 
 Reach of the unit check, measured (``tests/test_input_checks.py``; the ratio is the median
 gain over the bound): the rig's tanh device 0.8 (base_acc in g: 7.9; rel_acc in g: 90th
 percentile 0.10); a device with 30 N of friction under 8 m/s^2 0.33 (in g: 3.2, caught), under
 4 m/s^2 0.20 (in g: 2.0, NOT caught); the bundled records 0.4-0.9 and the detection grid's
-scenarios 0.3-1.0 raise nothing.
+scenarios 0.3-1.0 raise nothing. The frame of Marino and Cicirello (``harvester.data.public``,
+``tests/test_kinds.py``): as recorded (base_disp -> rel_disp) 1.5-1.6 above resonance; driven
+by the force K y (its friction on the ground) only below resonance, 0.80-0.98 there (0.5-1 Hz),
+its force in kN 796-979 (refused), in mN 0.00080-0.00098 (a warning). A narrow-band excitation
+with fewer than MIN_LINES coherent lines above resonance (and, for a base input, any below it:
+friction on the ground, written relative to the base, exceeds the bound there: the frame as
+recorded, 0.5-1 Hz, medians 6.3 and 12.6) is not judged: a slow displacement in mm then
+passes unless it moves faster than MAX_VELOCITY_RMS read as m (``fast_displacements``; the
+frame's displacements in mm move at 6.3-10.3 m/s RMS, caught; the rig's tanh device under
+three sines of 0.5 mm at 0.7-2.1 Hz, its rel_disp in mm at 0.86 m/s: NOT caught).
 
 Gravity left in an acceleration and displacements beyond 5 m are
 ``recording.check_plausible``'s (called from here). Checks that rest on linear theory (the
@@ -271,72 +280,120 @@ def _winsorised(x: np.ndarray) -> np.ndarray:
     return np.clip(x, med - SPIKE_ROBUST_SD * sd, med + SPIKE_ROBUST_SD * sd) if sd > 0 else x
 
 
-def gain_above_resonance(df: pd.DataFrame, kinds: RecordingKinds, dt: float,
-                         known: Mapping[str, float],
-                         lowpass_hz: float | None = None) -> dict | None:
-    """|output / input| above resonance against what a passive device allows there.
-
-    Measured: the median over FRF lines (Welch, 2 s segments, at least four and at least
-    MIN_SEGMENT_S long; at least MIN_LINES lines) with coherence >= MIN_COHERENCE
-    above RESONANCE_MARGIN x the natural frequency sqrt(k/M) / 2 pi (without M and k: the
-    upper half of the coherent lines), below 0.4 x the rate and 0.8 x ``lowpass_hz`` (a
-    low-pass of the output alone lowers the gain above it), of |H| in accelerations (times
-    w^2 for a displacement output, over w^2 for a displacement input; the kinds' ``order``,
-    ``harvester.data.kinds``), and its 90th percentile over the lines. Bound: eq. (1)
-    with any damping or friction, |z''/y''| <= (m/M) w^2 / (w^2 - w_n^2) for a base input
-    (m/M <= 1 when not known: M = m + J (2 pi / l)^2), |z''/F| <= (1/M) w^2 / (w^2 - w_n^2)
-    for a force input (None without M). Returns None when nothing can be judged.
-    """
+def _frf(df: pd.DataFrame, kinds: RecordingKinds, dt: float) -> tuple[np.ndarray, ...] | None:
+    """(f in Hz, coherence, |H| in accelerations, input power S_uu) of a recording (Welch,
+    2 s segments, at least four and at least MIN_SEGMENT_S long), or None for too short a
+    record. |H| is times w^2 for a displacement output and over w^2 for a displacement input
+    (the kinds' ``order``, ``harvester.data.kinds``)."""
     from harvester.data.kinds import input_kind, output_kind
     inp, out = input_kind(kinds.input_kind), output_kind(kinds.output_kind)
-    M, m, k = (known.get(p) for p in ("M", "m", "k"))
-    if inp.force_input and M is None:
-        return None
-    scale = 1.0 / M if inp.force_input else (m / M if M and m else 1.0)
     u, y = (_winsorised(df[c].to_numpy(float)) for c in (kinds.input_kind, kinds.output_kind))
     fs = 1.0 / dt
     nper = int(min(round(2.0 * fs), u.size // 4))
     if nper < MIN_SEGMENT_S * fs:
-        return None  # too short a record for a spectrum
+        return None
     kw = {"fs": fs, "nperseg": nper, "noverlap": nper // 2, "detrend": "linear"}
     f, s_uu = signal.welch(u, **kw)
     _, s_yy = signal.welch(y, **kw)
     _, s_uy = signal.csd(u, y, **kw)
     with np.errstate(divide="ignore", invalid="ignore"):
         coh = np.abs(s_uy) ** 2 / (s_uu * s_yy)
-        # in accelerations: a displacement output times w^2, a displacement input over w^2
         w = 2 * np.pi * f
         gain = np.abs(s_uy) / s_uu * w ** (2 - out.order) / (
             1.0 if inp.force_input else w ** (2 - inp.order))
-    top = min(0.4 * fs, 0.8 * lowpass_hz) if lowpass_hz else 0.4 * fs
-    ok = (f > 0) & (f < top) & (coh >= MIN_COHERENCE)
-    f_n = np.sqrt(k / M) / (2 * np.pi) if M and k else None
-    if f_n:
-        ok &= f > RESONANCE_MARGIN * f_n
-    elif ok.any():
-        ok &= f > np.median(f[ok])
-    if ok.sum() < MIN_LINES:
-        return {"lines": int(ok.sum()), "coherence": float(np.nanmax(coh[f > 0]))}
+    return f, coh, gain, s_uu
+
+
+def _judged(f: np.ndarray, gain: np.ndarray, ok: np.ndarray, scale: float,
+            f_n: float | None, side: str) -> dict:
+    """Median and 90th percentile of the gain over the lines ``ok`` against the bound
+    scale w^2 / |w^2 - w_n^2| (scale alone without f_n)."""
     w2 = (2 * np.pi * f[ok]) ** 2
-    bound = scale * w2 / (w2 - (2 * np.pi * f_n) ** 2 if f_n else w2)
+    bound = scale * w2 / (np.abs(w2 - (2 * np.pi * f_n) ** 2) if f_n else w2)
     ratio = gain[ok] / bound
     return {"lines": int(ok.sum()), "band_hz": (float(f[ok][0]), float(f[ok][-1])),
             "gain": float(np.median(gain[ok])), "ratio": float(np.median(ratio)),
             "ratio_p90": float(np.quantile(ratio, 0.9)), "scale": float(scale),
-            "known": bool(f_n)}
+            "known": bool(f_n), "side": side}
 
 
-#: The unit slip each input kind is most often recorded with.
-_SLIP_EXAMPLE = {"base_acc": "base_acc in g", "force": "force in kN",
-                 "base_disp": "base_disp in mm"}
+def gain_above_resonance(df: pd.DataFrame, kinds: RecordingKinds, dt: float,
+                         known: Mapping[str, float],
+                         lowpass_hz: float | None = None) -> dict | None:
+    """|output / input| away from resonance against what a passive device allows there.
+
+    Measured (:func:`_frf`): the median over FRF lines (at least MIN_LINES) with coherence
+    >= MIN_COHERENCE above RESONANCE_MARGIN x the natural frequency f_n = sqrt(k/M) / 2 pi
+    (without M and k: the upper half of the coherent lines), below 0.4 x the rate and 0.8 x
+    ``lowpass_hz`` (a low-pass of the output alone lowers the gain above it), and its 90th
+    percentile over the lines. Bound: eq. (1) with any damping or friction, |z''/y''| <=
+    (m/M) w^2 / (w^2 - w_n^2) for a base input (m/M <= 1 when not known: M = m + J (2 pi /
+    l)^2), |z''/F| <= (1/M) w^2 / |w^2 - w_n^2| for a force input (None without M). A force
+    input with fewer lines above resonance is judged below it (:func:`_below_resonance`).
+    ``side`` says which. Returns None when nothing can be judged.
+    """
+    force = kinds.input_kind == "force"
+    M, m, k = (known.get(p) for p in ("M", "m", "k"))
+    if force and M is None:
+        return None
+    frf = _frf(df, kinds, dt)
+    if frf is None:
+        return None  # too short a record for a spectrum
+    f, coh, gain, s_uu = frf
+    scale = 1.0 / M if force else (m / M if M and m else 1.0)
+    top = min(0.4 / dt, 0.8 * lowpass_hz) if lowpass_hz else 0.4 / dt
+    coherent = (f > 0) & (f < top) & (coh >= MIN_COHERENCE)
+    f_n = np.sqrt(k / M) / (2 * np.pi) if M and k else None
+    ok = coherent & (f > RESONANCE_MARGIN * f_n) if f_n else (
+        coherent & (f > np.median(f[coherent])) if coherent.any() else coherent)
+    if ok.sum() >= MIN_LINES:
+        return _judged(f, gain, ok, scale, f_n, "above")
+    if force and f_n:
+        below = _below_resonance(f, coherent, s_uu, top, f_n)
+        if below is not None:
+            return _judged(f, gain, below, scale, f_n, "below")
+    return {"lines": int(ok.sum()), "coherence": float(np.nanmax(coh[f > 0]))}
+
+
+#: Below resonance (force inputs): lines below f_n / RESONANCE_MARGIN, at least
+#: MIN_LINES_BELOW of them, holding at least MIN_POWER_BELOW of the input's power in the band.
+MIN_LINES_BELOW = 2
+MIN_POWER_BELOW = 0.5
+
+
+def _below_resonance(f: np.ndarray, coherent: np.ndarray, s_uu: np.ndarray, top: float,
+                     f_n: float) -> np.ndarray | None:
+    """The coherent lines below f_n / RESONANCE_MARGIN when they carry the excitation (a
+    force below resonance, as a frame driven through its spring, K y: there |z / F| <=
+    1 / |k - M w^2| whatever the damping, and friction, stiffening a stuck mass, lowers it),
+    else None."""
+    ok = coherent & (f < f_n / RESONANCE_MARGIN)
+    band = (f > 0) & (f < top)
+    power = float(np.sum(s_uu[ok]) / max(float(np.sum(s_uu[band])), 1e-300))
+    return ok if ok.sum() >= MIN_LINES_BELOW and power >= MIN_POWER_BELOW else None
+
+
+#: The unit slips that make the gain too high (an input too small, an output too large) and
+#: too low, for each kind.
+_SLIP_HIGH = {"base_acc": "base_acc in g", "force": "force in kN", "base_disp": None,
+              "rel_acc": "rel_acc in mm/s^2", "rel_disp": "rel_disp in mm"}
+_SLIP_LOW = {"base_acc": "base_acc in mm/s^2", "force": "force in mN",
+             "base_disp": "base_disp in mm", "rel_acc": "rel_acc in g", "rel_disp": None}
+
+
+def _slips(kinds: RecordingKinds, table: Mapping[str, str | None]) -> str:
+    """The slips of ``table`` this recording's input and output can have, e.g. 'force in kN
+    or rel_disp in mm'."""
+    found = [table[k] for k in (kinds.input_kind, kinds.output_kind) if table[k]]
+    return " or ".join(found)
 
 
 def check_units_by_physics(df: pd.DataFrame, kinds: RecordingKinds, dt: float,
                            known: Mapping[str, float], source: str | Path,
                            known_from: str = "the sidecar",
                            lowpass_hz: float | None = None) -> list[CheckWarning]:
-    """DataError when the gain above resonance (:func:`gain_above_resonance`, its median over
-    the lines) exceeds what a passive device allows by UNIT_RATIO (a unit slipped, or the
+    """DataError when the gain away from resonance (:func:`gain_above_resonance`, its median
+    over the lines) exceeds what a passive device allows by UNIT_RATIO (a unit slipped, or the
     sidecar's M, m are wrong); a warning when, with M (and m) known, even its 90th percentile
     is below 1 / (2 UNIT_RATIO) of it (friction lowers the gain most at low frequencies), or
     when input and output do not cohere."""
@@ -353,24 +410,24 @@ def check_units_by_physics(df: pd.DataFrame, kinds: RecordingKinds, dt: float,
     force = kinds.input_kind == "force"
     name = "1/M" if force else "m/M"
     what = (f"{name} = {g['scale']:.4g}, from {known_from}" if "M" in known else
-            f"{name} <= 1: M, m not known") + (", times w^2 / (w^2 - w_n^2)" if g["known"] else "")
-    evidence = (f"above resonance ({g['band_hz'][0]:.3g}-{g['band_hz'][1]:.3g} Hz, {g['lines']} "
-                f"FRF lines with coherence >= {MIN_COHERENCE}) the median {pair} is "
-                f"{g['gain']:.4g}, {g['ratio']:.3g} times the most a passive device allows "
+            f"{name} <= 1: M, m not known") + (", times w^2 / |w^2 - w_n^2|" if g["known"]
+                                                 else "")
+    evidence = (f"{g['side']} resonance ({g['band_hz'][0]:.3g}-{g['band_hz'][1]:.3g} Hz, "
+                f"{g['lines']} FRF lines with coherence >= {MIN_COHERENCE}) the median {pair} "
+                f"is {g['gain']:.4g}, {g['ratio']:.3g} times the most a passive device allows "
                 f"there ({what})")
     if g["ratio"] > UNIT_RATIO:
         raise DataError(source, f"{evidence}{_factor_named(g['ratio'])}: a unit slipped "
                         f"({kinds.input_kind} must be in {kinds.input_unit}, "
                         f"{kinds.output_kind} in {kinds.output_unit}; e.g. "
-                        f"{_SLIP_EXAMPLE[kinds.input_kind]}"
-                        f"), or the M, m in {known_from} are wrong")
+                        f"{_slips(kinds, _SLIP_HIGH)}), or the M, m in {known_from} are wrong")
     scale_known = "M" in known and ("m" in known or force)
     if scale_known and g["ratio_p90"] < 1.0 / (2.0 * UNIT_RATIO):
         return [CheckWarning(str(source), "unit", f"{evidence}; even its 90th percentile is "
                              f"{g['ratio_p90']:.3g} times it{_factor_named(g['ratio_p90'])}: "
                              "friction holding the mass, an output low-passed below these "
-                             "frequencies (give filtered_at_hz), or a unit slip (rel_acc in g, "
-                             "base_acc in mm/s^2, force in kN)")]
+                             "frequencies (give filtered_at_hz), or a unit slip "
+                             f"({_slips(kinds, _SLIP_LOW)})")]
     return []
 
 
