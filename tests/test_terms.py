@@ -73,3 +73,25 @@ def test_layout_refuses_a_repeated_term_and_two_couplings():
     assert Layout.of(["backlash"]).n_states == 4
     assert Layout.of([]).parameter_names == ("M", "m", "k", "c_m")
     assert np.all([Layout.of([n]).names == (n,) for n in TERMS])
+
+
+def test_friction_laws_and_their_refinements_are_friction_and_nothing_else_is():
+    from harvester.model.terms import is_friction, term
+    friction = {n for n in TERMS if is_friction(term(n))}
+    assert {"tanh_friction", "coulomb_friction", "hysteresis", "stribeck_friction",
+            "asymmetric_friction"} <= friction
+    assert not friction & {"cubic_stiffness", "unmodelled_mode", "inertia_error",
+                           "quadratic_damping", "end_stop", "offset_force"}
+
+
+def test_a_named_effect_is_said_with_its_kind_and_its_fitted_strength_in_its_unit():
+    from harvester.diagnosis.verdict import _level
+
+    class Fit:
+        def summary(self):
+            return {"F_hyst": {"mean": 0.6612, "sd": 0.0049}, "k_cubic": {"mean": 2.0e6,
+                                                                         "sd": 1.0e5}}
+    assert _level("hysteresis", Fit()) == "hysteresis (friction, F_hyst 0.661 +- 0.0049 N)"
+    assert _level("cubic_stiffness", Fit()).startswith("cubic_stiffness (k_cubic 2e+06 +- 1e+05 ")
+    assert _level("coulomb_friction", None) == "coulomb_friction (friction)"
+    assert _level("inertia_error", None) == "inertia_error"

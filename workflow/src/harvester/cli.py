@@ -529,6 +529,31 @@ def _diagnosis_inputs(args: argparse.Namespace):
     return df, validation, lowpass, kp.values, checked.sidecar, notes
 
 
+def _friction_form(args: argparse.Namespace, df, validation, known, sidecar, settings):
+    """(recording, validation, known, notes) in the form the device's friction acts in where
+    the sidecar does not say and both forms can be compared (``diagnosis.topology``): the
+    recording as it is, or rewritten with its friction on the ground (``data.kinds.on_ground``).
+    """
+    from harvester.data.kinds import on_ground
+    from harvester.diagnosis.topology import choose_topology, comparable
+    from harvester.initial.recording import diagnosis_priors
+    source = str(args.recording)
+    if sidecar.friction_on is not None or not comparable(df, known, source):
+        return df, validation, known, []
+
+    def priors_of(d, k):
+        return diagnosis_priors(d, args.baseline, k, sidecar.priors, settings.lowpass_hz,
+                                source)[0]
+    choice = choose_topology(df, known, args.baseline, priors_of, settings, source)
+    notes = [choice.sentence(source)]
+    if choice.chosen == "ground":
+        if validation is not None:
+            validation = on_ground(validation, known, str(args.validation))[0]
+        df, known, done = on_ground(df, known, source)
+        notes += done
+    return df, validation, known, notes
+
+
 def diagnose_command(args: argparse.Namespace) -> int:
     from harvester.data.fileio import atomic_directory, check_output_dir
     from harvester.diagnosis import check_recording, diagnose, write
@@ -539,6 +564,9 @@ def diagnose_command(args: argparse.Namespace) -> int:
     settings = _diagnosis_settings(args, lowpass)
     check_recording(df, str(args.recording), settings.lead_in_s,
                     0.0 if validation is not None else settings.holdout_fraction)
+    df, validation, known, form_notes = _friction_form(args, df, validation, known, sidecar,
+                                                       settings)
+    notes += form_notes
     try:
         priors, prior_notes = diagnosis_priors(df, args.baseline, known, sidecar.priors,
                                                settings.lowpass_hz, str(args.recording))

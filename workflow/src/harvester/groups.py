@@ -116,7 +116,11 @@ def prepare_recording(source: str | Path, sidecar: str | Path | None, out_csv: s
     workflow's own low-pass (``lowpass_hz``, applied before: rule ``lowpass``), else the
     sheet sidecar's, else the cut-off found from the output's spectrum
     (``diagnosis.spectral.filter_cutoff``), else none; every later step reads it from there.
-    Both files appear only when the checks pass (DataError naming the file otherwise).
+    Both files appear only when the checks pass (DataError naming the file otherwise). A
+    sidecar's ``friction_on: ground`` rewrites the recording in absolute coordinates
+    (``data.kinds.on_ground``), so that every later step fits the device's own form; the
+    workflow does not choose the form when the sidecar is silent (``harvester diagnose``
+    does: ``diagnosis.topology``).
     """
     from harvester.data.daq import read_checked_recording, sha256
     from harvester.data.sidecar import Sidecar, sidecar_path
@@ -140,11 +144,19 @@ def prepare_recording(source: str | Path, sidecar: str | Path | None, out_csv: s
     notes = [f"{name}: sidecar written by the workflow (rule prepare_recording) from "
              + (str(sidecar) if sidecar else "no sidecar"),
              f"filtered_at_hz: {where}"]
+    known, rewritten = dict(given.known), None
+    if given.friction_on == "ground":
+        from harvester.data.kinds import on_ground
+        rewritten, known, done = on_ground(first.data, known, str(source))
+        notes += done
     out_csv.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix=f".{name}.", dir=out_csv.parent) as staging:
         csv = Path(staging) / out_csv.name
-        shutil.copyfile(source, csv)
-        sidecar_path(csv).write_text(_sidecar_text(given.known, given.priors, cutoff, notes))
+        if rewritten is None:
+            shutil.copyfile(source, csv)
+        else:
+            rewritten.to_csv(csv, index=False, float_format="%.10g")
+        sidecar_path(csv).write_text(_sidecar_text(known, given.priors, cutoff, notes))
         checked = read_checked_recording(csv, known_from="its sidecar")
         os.replace(sidecar_path(csv), sidecar_path(out_csv))
         os.replace(csv, out_csv)
@@ -154,7 +166,8 @@ def prepare_recording(source: str | Path, sidecar: str | Path | None, out_csv: s
     return {"recording": name, "source": str(source), "sidecar_given": str(sidecar or ""),
             "input": checked.kinds.input_kind, "output": checked.kinds.output_kind,
             "samples": len(df), "sampling_rate_hz": 1.0 / checked.dt,
-            "duration_s": float(len(df) * checked.dt), "known": dict(given.known),
+            "duration_s": float(len(df) * checked.dt), "known": known,
+            "friction_on": given.friction_on or "base (not stated)",
             "priors_given": dict(given.priors), "filtered_at_hz": cutoff,
             "filtered_at_from": where, "warnings": [str(w) for w in checked.warnings],
             "sha256": sha256(out_csv)}

@@ -10,10 +10,12 @@ m              kg     oscillating mass (M >= m)
 k              N/m    spring stiffness
 priors                ``{parameter: {mean, sd}}``, e.g. a static test's ``F_c``
 filtered_at_hz Hz     cut-off of a zero-phase low-pass the recording already went through
-friction_on           ``base`` (default) or ``ground``: what the device's friction acts on,
-                      the velocity relative to the base, or the mass's own (a contact fixed
+friction_on           ``base`` or ``ground``: what the device's friction acts on, the
+                      velocity relative to the base, or the mass's own (a contact fixed
                       to the ground, as on the frame of Marino and Cicirello);
-                      ``harvester.data.kinds.on_ground`` writes such a recording
+                      ``harvester.data.kinds.on_ground`` writes such a recording. Not
+                      given: relative to the base, except where ``harvester diagnose``
+                      can compare both (``harvester.diagnosis.topology``)
 ============== ====== ===================================================================
 
 Parameters the sidecar does not give are identified where the method can (``harvester
@@ -53,7 +55,7 @@ class Sidecar:
     known: dict[str, float] = field(default_factory=dict)
     priors: dict[str, dict[str, float]] = field(default_factory=dict)
     filtered_at_hz: float | None = None
-    friction_on: str = "base"
+    friction_on: str | None = None  # None: not stated (relative to the base unless compared)
 
     def summary(self) -> dict[str, Any]:
         """For run.json: where it is and what it gave."""
@@ -139,8 +141,8 @@ def read_sidecar(recording: str | Path) -> Sidecar:
         raise DataError(path, f"m = {known['m']:g} kg > M = {known['M']:g} kg: impossible, the "
                         "effective mass M = m + J (2 pi / l)^2 includes m", line=lines.get("m"))
     cutoff = meta.get("filtered_at_hz")
-    friction_on = meta.get("friction_on", "base")
-    if friction_on not in ("base", "ground"):
+    friction_on = meta.get("friction_on")
+    if friction_on not in (None, "base", "ground"):
         raise DataError(path, f"'friction_on' must be base or ground (what the device's "
                         f"friction acts on), got {friction_on!r}", line=lines.get("friction_on"))
     return Sidecar(path, True, known, _priors(path, meta.get("priors", {}), lines.get("priors")),

@@ -214,12 +214,27 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
                    headline=headline(verdict, found, fit, baseline, limit, missing))
 
 
+def _level(effect: str, fit: ModelFit | None) -> str:
+    """A named effect with what it is, when a friction law, and its fitted strength (the
+    term's probe parameter, posterior mean +- sd, in its unit): "hysteresis (friction, F_hyst
+    0.661 +- 0.0049 N)". A name alone when the improved fit lacks the parameter."""
+    from harvester.model.terms import is_friction, term
+    t = term(effect)
+    what = "friction, " if is_friction(t) else ""
+    s = fit.summary().get(t.probe.strength) if fit is not None else None
+    if s is None:
+        return f"{effect} (friction)" if what else effect
+    unit = {p.name: p.unit for p in t.parameters}[t.probe.strength]
+    return (f"{effect} ({what}{t.probe.strength} {s['mean']:.3g} +- {s['sd']:.2g} "
+            f"{unit})").replace(" )", ")")
+
+
 def _named(found: Conclusion, missing: MissingForce | None) -> str:
     """The effects named and tied, with their size where the missing force gave it. The size
     is the improved model's force beyond the baseline's (``latent_views.effect_force``): with
     several effects added it is theirs together, and said once."""
-    groups = [" / ".join(g) for g in [[e] for e in found.missing] + [t.effects
-                                                                       for t in found.ties]]
+    groups = [" / ".join(g) for g in [[_level(e, found.improved_fit)] for e in found.missing]
+              + [t.effects for t in found.ties]]
     sizes = missing.sizes if missing is not None else []
     if not sizes:
         return ", ".join(groups)

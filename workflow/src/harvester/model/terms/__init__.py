@@ -192,6 +192,12 @@ BASE_PARAMETERS: tuple[Parameter, ...] = (
 SLIDING_FRICTION: tuple[str, ...] = ("tanh_friction", "coulomb_friction", "hysteresis")
 
 
+def is_friction(t: Term) -> bool:
+    """Whether a term is a friction law: a sliding law (``SLIDING_FRICTION``, Dahl's
+    pre-sliding ``hysteresis`` among them) or a refinement of one (Stribeck, asymmetry)."""
+    return t.name in SLIDING_FRICTION or bool(set(t.refines) & set(SLIDING_FRICTION))
+
+
 def check_term(t: Term) -> None:
     """ValueError naming what a term lacks (the registry's conditions)."""
     problems = []
