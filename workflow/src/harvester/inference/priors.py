@@ -17,12 +17,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
-from harvester.model.priors import REFERENCE_DEVICE, DeviceScale, PriorSpec
+from harvester.model.priors import REFERENCE_DEVICE, Z_QUANTILES, DeviceScale, PriorSpec
 from harvester.model.terms import BASE_PARAMETERS, TERMS
 from harvester.study import paper
 
 __all__ = ["PAPER_PRIORS", "PriorSpec", "default_prior", "prior_moments", "prior_spec",
-           "prior_table", "priors_for"]
+           "prior_table", "priors_for", "recording_scale"]
 
 if TYPE_CHECKING:
     from harvester.inference.likelihood import Problem
@@ -120,6 +120,49 @@ def default_prior(name: str, device: DeviceScale = REFERENCE_DEVICE) -> PriorSpe
         if p.name == name:
             return p.prior_on(device)
     raise KeyError(f"no prior for parameter {name!r}")
+
+
+#: Top of the band a recording's scale names (``DeviceScale.f_high``), as a fraction of its
+#: low-pass (or Nyquist) frequency: the diagnosis's detection band ends at 0.9 x it.
+SCALE_BAND_TOP = 0.9
+
+
+def recording_scale(df: pd.DataFrame, values: Mapping[str, float],
+                    lowpass_hz: float | None = None, lead_in_s: float = 1.0,
+                    source: str = "<recording>") -> DeviceScale | None:
+    """The scales (``DeviceScale``) a recorded device's term priors are read on, measured
+    from a recording of its displacement after ``lead_in_s`` (s): RMS z (m, about its
+    median) and the quantiles of |z|, RMS velocity v (m/s, z differentiated), the damping
+    force c_eq v by the power balance (N; the reference rig's where that cannot tell), the
+    band's top f_high (Hz, SCALE_BAND_TOP) and M, m, k from ``values`` (known or fitted;
+    NaN where absent): what the diagnosis takes from its baseline's simulated motion
+    (``harvester.diagnosis.signatures.motion_scale``), here without a model, for
+    ``harvester identify`` and ``compare`` on a device unlike the paper's rig (a circuit in
+    volts: k_cubic's prior in k / z^2 is 1e5 times narrower than on the rig's scale).
+
+    None for an acceleration output: z integrated twice from z'' is no level to trust (the
+    tanh rig's simulated record: 0.47 x its RMS z by a windowed spectrum above 0.3 Hz, up to
+    8.6 x by an FFT integral of a sine; measured)."""
+    from harvester.data.kinds import derivative, input_kind, model_recording, output_kind
+    from harvester.data.recording import recording_kinds
+    from harvester.data.signals import uniform_step
+    df, _ = model_recording(df, lowpass_hz, source)
+    kinds = recording_kinds(df, source)
+    inp, out = input_kind(kinds.input_kind), output_kind(kinds.output_kind)
+    if out.order != 0:
+        return None
+    dt = uniform_step(df["time"].to_numpy(dtype=float), source)
+    y = df[out.name].to_numpy(dtype=float)
+    cut = slice(min(int(round(lead_in_s / dt)), len(y) // 4), None)
+    v = derivative(y, dt, 1, lowpass_hz)[cut]
+    az = np.abs(y[cut] - np.median(y[cut]))
+    force = inp.dissipative_force(df[inp.name].to_numpy(dtype=float)[cut], v, values)
+    return DeviceScale(force=force or REFERENCE_DEVICE.force,
+                       v=float(np.sqrt(np.mean(v**2))) or 1e-3,
+                       z=float(np.sqrt(np.mean(az**2))) or 1e-3,
+                       f_high=float(SCALE_BAND_TOP * (lowpass_hz or 0.5 / dt)),
+                       **{n: float(values.get(n, np.nan)) for n in ("M", "m", "k")},
+                       z_quantiles={q: float(np.quantile(az, q)) for q in Z_QUANTILES})
 
 
 def priors_for(problem: Problem, priors: Mapping[str, PriorSpec],

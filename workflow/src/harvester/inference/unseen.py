@@ -137,3 +137,27 @@ def write_prediction(pred: Prediction, directory: Path, figures: bool = True,
         files.append("predictive.png")
     write_json(pred.metrics, directory / "validation.json")
     return files + ["validation.json"]
+
+
+def heldout_error(problem: Problem, theta: np.ndarray, input: np.ndarray,
+                  output: np.ndarray, section: tuple[int, int]) -> dict:
+    """The simulation error of a fit on samples it did not use: each row of ``theta``
+    (free parameters..., sigma; e.g. thinned posterior samples) simulated from rest for
+    ``input`` alone (the problem's input kind and sampling step: the fitted record's input
+    continued by the held-out one), through the problem's output filter; their mean (the
+    predictive mean) against the measured ``output`` over samples [start, stop) of
+    ``section``. Returns the RMS error and the RMS of the measured output there (both in
+    the output's unit), the NRMSE, the section (s) and the rows simulated."""
+    start, stop = section
+    if not 0 <= start < stop <= len(output) == len(input):
+        raise ValueError(f"section {section} outside the {len(output)} samples given "
+                         f"(input {len(input)})")
+    held = problem.replace(input=np.asarray(input, dtype=float),
+                           output=np.asarray(output, dtype=float), window=(start, stop))
+    t = np.arange(len(input)) * problem.dt
+    band = posterior_predictive(held, np.atleast_2d(theta), held.input, t)
+    y, mean = held.output[start:stop], band.mean[start:stop]
+    return {"model": problem.structure.name, "rms_error": float(np.sqrt(np.mean((y - mean)**2))),
+            "rms_output": float(np.std(y)), "nrmse": nrmse(y, mean),
+            "section_s": [float(t[start]), float(t[stop - 1])], "samples": len(band.sigma),
+            "unit": UNITS[problem.output_kind]}

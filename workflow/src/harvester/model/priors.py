@@ -180,6 +180,11 @@ class DeviceScale:
         return float(getattr(self, name))
 
 
+#: Quantiles of |z| a device's scale records (``DeviceScale.z_quantiles``; 1.0: the largest),
+#: as ``harvester.diagnosis.signatures.Z_QUANTILES``.
+Z_QUANTILES = (0.5, 0.75, 0.9, 0.97, 0.99, 0.999, 1.0)
+
+
 #: The paper's rig as the study's virtual rig drives it: the tanh model at Table 5's means on
 #: the filtered training record (results/data/training_filtered.csv, samples 256-2256):
 #: dissipative force 7.36 N, RMS velocity 0.0115 m/s, RMS displacement 2.46 mm, quantiles of
