@@ -189,7 +189,7 @@ def identification_priors(df: pd.DataFrame, free: tuple[str, ...],
     """
     from harvester.data.recording import recording_kinds
     from harvester.data.signals import sampling_rate
-    from harvester.inference.priors import default_prior
+    from harvester.inference.priors import default_prior, recording_scale
     from harvester.initial.frf import initial_priors, sigma_prior
     from harvester.study.paper import TABLE1
 
@@ -206,19 +206,26 @@ def identification_priors(df: pd.DataFrame, free: tuple[str, ...],
         notes.append(f"priors of {', '.join(specs)}: from the recording's FRF with the known "
                      f"{', '.join(sorted(scale))} (as harvester diagnose)")
     base = tuple(p for p in ("M", "m", "k", "c_m") if p in free and p not in specs)
+    values = dict(known)
     if base:
         top = FRF_BAND_TOP * (lowpass_hz or 0.5 * sampling_rate(df, source))
         fit, frf = initial_priors(df, known, base, (FRF_BAND_LOW_HZ, top), source=source)
         specs.update({p: frf[p] for p in base})
+        values.update({p: fit.values[p] for p in base})
         notes += fit.notes
         notes.append(f"priors of {', '.join(base)}: a linear FRF fit over "
                      f"{FRF_BAND_LOW_HZ:g}-{top:.3g} Hz (" + ", ".join(
                          f"{p} = {fit.values[p]:.4g}" for p in base) + ")")
     specs["sigma"] = sigma_prior(df)
     rest = [p for p in free if p not in specs]
-    specs.update({p: default_prior(p) for p in rest})
+    device = recording_scale(df, values, lowpass_hz, source=source) if rest else None
+    specs.update({p: default_prior(p) if device is None else default_prior(p, device)
+                  for p in rest})
     if rest:
-        notes.append(f"priors of {', '.join(rest)}: the library's defaults (the paper's rig)")
+        notes.append(f"priors of {', '.join(rest)}: the library's, " + (
+            "on the paper's rig (an acceleration output gives no trusted z)" if device is None
+            else f"on the recording's scale (RMS z {device.z:.3g} m, v {device.v:.3g} m/s; "
+                 f"k {device.k:.3g} N/m)"))
     for name, entry in (given or {}).items():
         unit = specs[name].unit if name in specs else default_prior(name).unit
         specs[name] = prior_spec(name, {"unit": unit, **entry}, TABLE1)
