@@ -4,7 +4,7 @@ held-out samples beside what is published for the benchmark (issue 41).
     .venv/bin/python benchmarks/bench_silverbox.py [--out DIR] [--fit-samples N]
                                                    [--held-samples N] [--skip-diagnose]
 
-Reads ../shared/data/silverbox/Schroeder80mV.mat (skips with a message when it is absent),
+Reads data/public/silverbox/Schroeder80mV.mat (the bundled copy; skips with a message when it is absent),
 writes the first ``--fit-samples`` of its multisine (8 s by default, in volts; no sidecar)
 and runs, each timed by the wall clock:
 
@@ -33,7 +33,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-SILVERBOX = ROOT.parent / "shared" / "data" / "silverbox" / "Schroeder80mV.mat"
+SILVERBOX = ROOT / "data" / "public" / "silverbox" / "Schroeder80mV.mat"
 MODELS = ("linear", "linear+cubic_stiffness")
 #: Posterior rows simulated for the held-out predictive mean.
 SAMPLES = 100
@@ -128,7 +128,7 @@ def main(argv: list[str] | None = None) -> int:
     args = p.parse_args(argv)
     if not SILVERBOX.is_file():
         print(f"skipped: {SILVERBOX} is absent (the Silverbox recording, see "
-              "../shared/data/silverbox/SOURCE.md)")
+              "data/public/silverbox/SOURCE.md)")
         return 0
     from harvester.data.public import silverbox_heldout
     held = silverbox_heldout(SILVERBOX, args.fit_samples, args.held_samples)

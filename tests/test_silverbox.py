@@ -3,7 +3,7 @@ on the recording's own scale (``inference.priors.recording_scale``), the simulat
 held-out samples (``inference.unseen.heldout_error``), the Silverbox cut for it
 (``data.public.silverbox_heldout``) and the integrator's accuracy on the circuit's scale.
 
-Fast: no sampling; the real record is read from ../shared/data when it is there (skipped
+Fast: no sampling; the real record is the bundled copy in data/public (skipped
 otherwise).
 """
 
@@ -20,7 +20,7 @@ from harvester.inference.problems import make_problem
 from harvester.inference.unseen import heldout_error
 from harvester.model.priors import REFERENCE_DEVICE
 
-SILVERBOX = Path(__file__).resolve().parents[2] / "shared" / "data" / "silverbox" / \
+SILVERBOX = Path(__file__).resolve().parents[1] / "data" / "public" / "silverbox" / \
     "Schroeder80mV.mat"
 FS = 500.0
 
@@ -82,7 +82,7 @@ def test_the_heldout_error_is_the_simulation_error() -> None:
         heldout_error(problem, theta, u, y, (2000, 3001))
 
 
-@pytest.mark.skipif(not SILVERBOX.is_file(), reason="no ../shared/data/silverbox")
+@pytest.mark.skipif(not SILVERBOX.is_file(), reason="no data/public/silverbox")
 def test_the_silverbox_cut_and_its_integration() -> None:
     """The fitted samples are the first ones of the whole record read on; on the circuit's
     scale (M, k from its linear FRF fit, k_cubic at 3 sd of its prior on the recording's

@@ -112,7 +112,15 @@ def converted_file(record):
     raw_daq recording converted (rule convert)."""
     if record in SHEET.table.index and SHEET.row(record)["kind"] == "converted":
         return SHEET.file(record)
+    if record in SHEET.table.index and SHEET.row(record)["kind"] == "public":
+        return public_csv(record)
     return f"results/data/{record}_acc.csv"
+
+
+def public_csv(record):
+    """A public recording read into the recording format (rule convert_public), its sidecar
+    beside it."""
+    return f"results/data/{record}_public.csv"
 
 
 def prepare_inputs(wildcards):
@@ -125,6 +133,8 @@ def prepare_inputs(wildcards):
     files = {"data": f"results/data/{rec}_filtered.csv" if lowpass else converted_file(rec)}
     if SHEET.sidecar(rec):
         files["sidecar"] = SHEET.sidecar(rec)
+    elif SHEET.row(rec)["kind"] == "public":
+        files["sidecar"] = public_csv(rec).replace(".csv", ".yaml")
     return files
 
 
@@ -185,7 +195,7 @@ def diagnosable(group):
     s = GROUPS[group]
     if not s["diagnose"]:
         return False
-    if group == STUDY_GROUP:
+    if group == STUDY_GROUP or isinstance(s["diagnose"], list):  # asked for by name
         return True
     rec = SHEET.groups[group].training
     force = SHEET.row(rec)["kind"] == "converted" and \
@@ -205,6 +215,13 @@ def diagnosable(group):
 
 
 DIAGNOSED = {g: diagnosable(g) for g in GENERIC_GROUPS}
+
+
+def diagnosed_model(group, model):
+    """Whether a model of a diagnosed group is diagnosed: all, or those config
+    groups.<group>.diagnose lists."""
+    asked = GROUPS[group]["diagnose"]
+    return model in asked if isinstance(asked, list) else bool(asked)
 
 
 def diagnosis_file(group, model, name="diagnosis.json"):
@@ -231,7 +248,7 @@ def group_outputs(group):
     for m in group_models(group):
         out += [model_file(group, m, n) for n in ("summary.csv", "posterior_pairs.png")]
         out += [f"{validation_dir(group, m, r)}/predictive.png" for r in grp.validation]
-        if DIAGNOSED[group]:
+        if DIAGNOSED[group] and diagnosed_model(group, m):
             out.append(diagnosis_file(group, m, "summary.html"))
     return out
 

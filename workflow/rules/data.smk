@@ -62,6 +62,24 @@ rule convert:
         "../scripts/convert.py"
 
 
+rule convert_public:
+    """A public benchmark's .mat file (sheet kind public) read into the recording format with
+    the sidecar its source gives (harvester.data.public; the files are never modified)."""
+    input:
+        lambda w: SHEET.file(w.record),
+    output:
+        csv="results/data/{record}_public.csv",
+        sidecar="results/data/{record}_public.yaml",
+    wildcard_constraints:
+        record=one_of(SHEET.recordings(kind="public")),
+    log:
+        "logs/convert_public_{record}.log",
+    conda:
+        ENV
+    script:
+        "../scripts/convert_public.py"
+
+
 rule prepare_recording:
     """A recording of the sheet as its group uses it: copied with its sidecar (filtered_at_hz
     set) beside it, checked; what the checks found in RECORDING.check.json."""

@@ -36,13 +36,12 @@ from harvester.data.signals import lowpass
 FRAME_DEVICE = {"M": 3.0799, "m": 3.0799, "k": 1191.0}
 #: The frame's viscous damping C (N s/m, the authors' initial estimate).
 FRAME_DAMPING = 0.669
-#: Zero-phase low-pass (Hz, order 8) of both frame channels.
-FRAME_LOWPASS_HZ = 20.0
-#: ... in the ground topology: above 10 Hz the channels hold sensor noise only (SOURCE.md),
-#: and that noise is common to both lasers: with the 20 Hz low-pass the storey's x follows
-#: F = K y at 9.5-15.5 Hz with 17.9 times the gain a passive mass allows (the unit check's
-#: error), which relative to the base (x - y) does not show.
-FRAME_GROUND_LOWPASS_HZ = 10.0
+#: Zero-phase low-pass (Hz, order 8) of both frame channels: above 10 Hz they hold sensor
+#: noise only (SOURCE.md), and that noise is common to both lasers: with a 20 Hz low-pass the
+#: storey's absolute x follows F = K y at 9.5-15.5 Hz with 17.9 times the gain a passive mass
+#: allows (the unit check's error), which relative to the base (x - y) does not show, so a
+#: recording rewritten with its friction on the ground (``kinds.on_ground``) would carry it.
+FRAME_LOWPASS_HZ = 10.0
 FRAME_FILTER_ORDER = 8
 #: The benchmark's own test sets, on another record (SNLS80mV.mat, not Schroeder80mV.mat), as
 #: nonlinearbenchmark.org's data loader cuts them (github.com/GerbenBeintema/
@@ -71,7 +70,8 @@ class PublicRecording:
     notes: list[str] = field(default_factory=list)
 
     def write(self, csv_path: str | Path) -> Path:
-        """The recording as ``csv_path`` and its sidecar beside it (``.yaml``)."""
+        """The recording as ``csv_path`` and its sidecar beside it (``.yaml``, the notes as
+        comments; written also when the source gives no values, so that it says so)."""
         import yaml
 
         from harvester.data.daq import write_recording
@@ -79,8 +79,10 @@ class PublicRecording:
         csv_path = Path(csv_path)
         csv_path.parent.mkdir(parents=True, exist_ok=True)
         write_recording(self.data, csv_path)
-        if self.sidecar:
-            sidecar_path(csv_path).write_text(yaml.safe_dump(self.sidecar, sort_keys=False))
+        head = "".join(f"# {line}\n" for line in self.notes)
+        body = yaml.safe_dump(self.sidecar, sort_keys=False) if self.sidecar else \
+            "# no device values: its source gives none in SI units\n"
+        sidecar_path(csv_path).write_text(head + body)
         return csv_path
 
 
@@ -129,7 +131,7 @@ def marino_frame(directory: str | Path, load_g: int, friction_on: str = "base"
         raise ValueError(f"friction_on must be 'base' or 'ground', got {friction_on!r}")
     if friction_on == "ground":
         from harvester.data.kinds import derivative
-        cut = FRAME_GROUND_LOWPASS_HZ
+        cut = FRAME_LOWPASS_HZ
         base = lowpass(y["y"] / 1000.0, fs, cut, FRAME_FILTER_ORDER)
         storey = lowpass(x["x"] / 1000.0, fs, cut, FRAME_FILTER_ORDER)
         y_vel = derivative(base, 1.0 / fs, 1, cut)
@@ -197,3 +199,29 @@ def silverbox_heldout(path: str | Path, fit_samples: int, held_samples: int,
     fit = silverbox(path, start, fit_samples)
     return HeldOut(fit, whole, (fit_samples, fit_samples + held_samples))
 
+
+#: Samples of the Silverbox the study reads (8 s from SILVERBOX_START).
+SILVERBOX_STUDY_SAMPLES = 4883
+
+
+def public_recording(path: str | Path) -> PublicRecording:
+    """A public benchmark's file read by its name (the recording sheet's kind ``public``):
+    ``s_b_{load}g_x.mat`` the frame at that load (:func:`marino_frame` as recorded, with its
+    ``_y.mat`` beside it; the sidecar adds ``friction_on: ground``, what its source says of
+    the contact), ``Schroeder80mV.mat`` the Silverbox's first
+    :data:`SILVERBOX_STUDY_SAMPLES` samples of the multisine (:func:`silverbox`). DataError
+    for any other file."""
+    import re
+    path = Path(path)
+    frame = re.fullmatch(r"s_b_(\d+)g_x\.mat", path.name)
+    if frame:
+        rec = marino_frame(path.parent, int(frame.group(1)))
+        rec.sidecar["friction_on"] = "ground"
+        rec.notes.append(f"{path.name}: friction_on: ground (the contact is fixed to the "
+                         "ground: SOURCE.md)")
+        return rec
+    if path.name == "Schroeder80mV.mat":
+        return silverbox(path, samples=SILVERBOX_STUDY_SAMPLES)
+    raise DataError(path, "not a public recording this reader knows: expected the frame's "
+                    "s_b_{load}g_x.mat (with its _y.mat beside it) or the Silverbox's "
+                    "Schroeder80mV.mat")

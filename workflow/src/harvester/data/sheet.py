@@ -10,8 +10,11 @@ recording name (letters, digits, ``_``, ``-``), unique over the sheets; names th
           written for it
 file      the recording: a CSV in the recording format (kind ``converted``,
           ``harvester.data.recording``), the virtual rig's raw DAQ volts (``raw_daq``: CSV
-          with its JSON beside it, converted first) or an EMPS .mat file (``emps``)
-kind      converted | raw_daq | emps
+          with its JSON beside it, converted first), an EMPS .mat file (``emps``) or a
+          public benchmark's .mat file read by ``harvester.data.public`` (``public``: the
+          frame's ``s_b_{load}g_x.mat`` with its ``_y.mat`` beside it, the Silverbox's
+          ``Schroeder80mV.mat``; its sidecar is the reader's)
+kind      converted | raw_daq | emps | public
 sidecar   YAML with what is known of the device (``harvester.data.sidecar``: M, m, k,
           priors, filtered_at_hz); empty: ``RECORDING.yaml`` beside the file if there is one
 role      training (identified on) | validation (unseen: predicted, never fitted)
@@ -38,7 +41,8 @@ from harvester.data.errors import DataError
 COLUMNS: tuple[str, ...] = ("recording", "file", "kind", "sidecar", "role", "group")
 OPTIONAL_COLUMNS: tuple[str, ...] = ("notes",)
 #: Kinds of recording and the file each takes.
-KINDS: dict[str, str] = {"converted": ".csv", "raw_daq": ".csv", "emps": ".mat"}
+KINDS: dict[str, str] = {"converted": ".csv", "raw_daq": ".csv", "emps": ".mat",
+                         "public": ".mat"}
 ROLES: tuple[str, ...] = ("training", "validation")
 #: The chain a group runs: its recordings' kinds (all emps, or none).
 GENERIC, EMPS = "generic", "emps"
@@ -215,9 +219,11 @@ def _check_files(path: Path, row: pd.Series, bases: Sequence[Path]) -> dict[str,
                             f"beside it: {meta} not found", line=line, column="file")
     sidecar = row["sidecar"]
     if sidecar:
-        if kind == "emps":
-            raise DataError(path, "an EMPS recording takes no sidecar (the drive's constants "
-                            "are in the .mat file)", line=line, column="sidecar")
+        if kind in ("emps", "public"):
+            raise DataError(path, f"an {kind} recording takes no sidecar (" + (
+                "the drive's constants are in the .mat file" if kind == "emps" else
+                "its reader, harvester.data.public, gives what its source publishes")
+                + ")", line=line, column="sidecar")
         sidecar = _resolved(path, line, "sidecar", sidecar, bases, "sidecar")
     elif kind == "converted":
         beside = Path(file).with_suffix(".yaml")
