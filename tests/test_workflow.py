@@ -70,6 +70,26 @@ def test_the_shipped_sheets_give_the_paper_and_emps_groups():
         (20.0, 1.0, 2000 / 256, "study")
 
 
+def test_the_public_sheet_gives_the_real_recordings_groups(tmp_path):
+    """The frame (both loads) and the Silverbox, kind public, each alone in its group; their
+    reader's sidecar states the frame's friction on the ground, and the workflow's
+    prepare_recording rewrites the frame so (force k y -> the storey's x)."""
+    from harvester.data.public import public_recording
+    from harvester.groups import prepare_recording
+    sheet = load_sheets(["config/public/recordings.tsv"], SCHEMA, bases=(ROOT,))
+    assert set(sheet.groups) == {"frame_250g", "frame_450g", "silverbox"}
+    assert all(sheet.row(r)["kind"] == "public" for r in sheet.recordings())
+    assert group_settings(CONFIG, "frame_450g")["diagnose"] == ["linear"]
+    frame = public_recording(ROOT / "data/public/marino-frame/s_b_250g_x.mat")
+    assert frame.sidecar["friction_on"] == "ground"
+    csv = frame.write(tmp_path / "frame.csv")
+    out = prepare_recording(csv, csv.with_suffix(".yaml"), tmp_path / "g/frame.csv")
+    assert (out["input"], out["output"], out["friction_on"]) == ("force", "rel_disp", "ground")
+    assert "m" not in out["known"] and out["known"]["k"] == 1191.0
+    with pytest.raises(DataError, match="not a public recording this reader knows"):
+        public_recording(tmp_path / "frame.csv")
+
+
 @pytest.mark.parametrize("rows, message", [
     ([["a", "a.csv", "csv", "", "training", "g"]], "line 2, column 'kind': unknown kind 'csv'"),
     ([["a", "missing.csv", "converted", "", "training", "g"]],
@@ -122,7 +142,10 @@ def test_dry_runs_of_the_shipped_sheets(tmp_path):
     proc = snakemake(tmp_path, "-n", "all")
     assert proc.returncode == 0, (proc.stdout + proc.stderr)[-4000:]
     both = job_counts(proc.stdout)
-    assert both["identify"] == both["diagnose"] == both["validate_recording"] == 2
+    # the paper's two models and the real recordings' groups (two models each, their linear
+    # model diagnosed; no validation recordings: the diagnosis holds out each record's end)
+    assert both["identify"] == 2 + 3 * 2 and both["diagnose"] == 2 + 3
+    assert both["validate_recording"] == 2 and both["convert_public"] == 3
     assert both["emps_tmcmc"] == 4 and both["fig10_tanh_unseen_full"] == 1
     emps = snakemake(tmp_path, "-n", "all", "--configfile", str(ROOT / "config/emps.yaml"))
     assert emps.returncode == 0, (emps.stdout + emps.stderr)[-4000:]
