@@ -303,8 +303,10 @@ def diagnose_model(data: str | Path, validation: str | Path | None, posterior: s
                    out_dir: str | Path):
     """The diagnosis of one identified model on the group's training recording, with its
     first validation recording (if any) for the before/after comparison; the window is the
-    group's (``window_samples``), the settings config ``diagnosis`` (``DiagnosisSettings``),
-    the low-pass the sidecar's. Writes diagnosis.json and its figures in ``out_dir``."""
+    group's (``window_samples``; without a validation recording the whole record, whose last
+    quarter the diagnosis holds out: the group's ``fit_seconds`` should leave it unfitted),
+    the settings config ``diagnosis`` (``DiagnosisSettings``), the low-pass the sidecar's.
+    Writes diagnosis.json and its figures in ``out_dir``."""
     import arviz as az
 
     from harvester.data.daq import read_checked_recording
@@ -325,6 +327,8 @@ def diagnose_model(data: str | Path, validation: str | Path | None, posterior: s
                             lowpass_hz=checked.sidecar.filtered_at_hz,
                             filter_order=int(settings["filter_order"]))
     lead_in, samples = window_samples(settings, 1.0 / checked.dt)
+    if unseen is None:  # the diagnosis holds out the record's end, which no fit has seen
+        samples = None
     return diagnose_study(checked.data, model, known, priors, unseen, diag_settings, out_dir,
                           posterior=az.from_netcdf(posterior), lead_in=lead_in,
                           samples=samples)
