@@ -20,7 +20,7 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import pandas as pd
 
@@ -106,11 +106,18 @@ def choose_topology(df: pd.DataFrame, known: Mapping[str, float], baseline: str,
                     priors_of, settings: DiagnosisSettings, source: str = "<recording>"
                     ) -> TopologyChoice:
     """Compare the two forms (module docstring). ``priors_of(df, known)`` gives a form's
-    priors (``initial.recording.diagnosis_priors``'s first item); ``settings.lowpass_hz``
-    should be the recording's (the same low-pass in both forms)."""
+    priors (``initial.recording.diagnosis_priors``'s first item); ``settings.lowpass_hz``:
+    the recording's low-pass, the same in both forms (None: found in its rel_disp's spectrum).
+    """
     clock = time.perf_counter()
     s = friction_structure(baseline)
     forms = {f: _form(df, known, f, source) for f in FORMS}
+    if settings.lowpass_hz is None:  # one low-pass for both: the recording's, as recorded
+        from harvester.data.signals import uniform_step
+        from harvester.diagnosis.spectral import filter_cutoff
+        dt = uniform_step(df["time"].to_numpy(dtype=float), source)
+        settings = replace(settings, lowpass_hz=filter_cutoff(
+            df["rel_disp"].to_numpy(dtype=float), 1.0 / dt))
     first = {f: _mode(*forms[f], s, priors_of, settings, source) for f in FORMS}
     temper = min(estimate_temper(mp.residual, a.fit_window, a.fs, a.f_high)
                  for a, mp in first.values())
