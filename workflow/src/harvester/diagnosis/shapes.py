@@ -18,6 +18,8 @@ shares are of what varies.
 ``periodic in z``   a cos(2 pi z / P) + b sin(2 pi z / P), the period P scanned (cogging,
                     a ball screw's or a gear's pitch, a magnetic detent)
 ``drift``           f_0 + s t (a slow change: temperature, a sensor's offset creeping)
+``drifting friction``  (F + s t) tanh(z' / v_0) + c z', v_0 scanned (a friction level that
+                    changes slowly: a lubricant warming; a slow force itself z'' cannot see)
 ``line``            a cos(2 pi f_0 t) + b sin(2 pi f_0 t), f_0 from the force's periodogram
                     (mains hum, a motor's or a pump's frequency, a structural mode driven
                     from outside)
@@ -32,6 +34,7 @@ shares are of what varies.
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -177,6 +180,45 @@ def _sign_law(lf: LatentForce, f: np.ndarray, w: np.ndarray, name: str, what: st
 def friction(lf: LatentForce, f: np.ndarray) -> Shape:
     """F tanh(z' / v_0): friction on the velocity relative to the base."""
     return _sign_law(lf, f, lf.rel_vel, "friction", "z'")
+
+
+#: Where |z'| exceeds this many of its posterior sd, its sign is known: the drifting friction's
+#: level and trend are read there.
+SURE_SIGN_SD = 3.0
+
+
+def drifting_friction(lf: LatentForce, f: np.ndarray) -> Shape:
+    """(F + s (t - t_mid)) tanh(z' / v_0) + c z' (N, N/s, N s/m), v_0 scanned as for
+    ``friction``: a friction whose level changes slowly over the window (a lubricant warming).
+    Its share is the scanned fit's over the window (its bases hold friction's, so it goes
+    first only by SHARE_MARGIN more). F and s are read where |z'| > SURE_SIGN_SD sd of its
+    draws: near a reversal the smoothed z' carries the wrong sign often enough to attenuate
+    the law, and more where the motion is slower, which biases a trend (on a test record
+    whose envelope slowed the motion from 20 to 13 mm/s RMS, 0.20 N/s for 0.25 over all
+    samples, 0.235 where the sign is sure)."""
+    w = lf.rel_vel
+    t = lf.time - 0.5 * (lf.time[0] + lf.time[-1])
+    sv = _rms(w)
+
+    def basis(v0: float) -> np.ndarray:
+        sign = np.tanh(w / v0)
+        return np.column_stack([sign, t * sign, w])
+
+    v0, coef, fitted, share = _scan(f, basis, np.geomspace(1e-3 * sv, sv, SCAN_POINTS),
+                                    lf.band)
+    if lf.state_draws.shape[1] > 1:
+        sure = np.abs(w) > SURE_SIGN_SD * lf.state_draws[1].std(axis=0)
+        if sure.sum() > 10 * basis(v0).shape[1]:
+            banded = lf.band(basis(v0).T).T
+            coef, *_ = np.linalg.lstsq(banded[sure], f[sure], rcond=None)
+    span = float(lf.time[-1] - lf.time[0])
+    sentence = (f"a friction-like force F sgn(z') drifting in time, {coef[1]:.3g} N/s (from "
+                f"{coef[0] - 0.5 * span * coef[1]:.3g} N to {coef[0] + 0.5 * span * coef[1]:.3g} "
+                f"N over {span:.3g} s; smoothed over {1e3 * v0:.2g} mm/s, with {coef[2]:.3g} "
+                f"N s/m of viscous damping), {_explains(share)}")
+    return Shape("drifting friction", share, {"F_N": coef[0], "slope_N_per_s": coef[1],
+                                              "v0_m_per_s": v0, "c_N_s_per_m": coef[2]},
+                 sentence, fitted)
 
 
 def base_velocity(lf: LatentForce) -> np.ndarray:
@@ -379,8 +421,8 @@ def inertial(lf: LatentForce, f: np.ndarray) -> Shape:
 #: -f / M, so a regression on z'' explains any fast force as a large negative mass error (a
 #: Coulomb force of 6 N came out as dM = -10 kg on M = 12.8 kg, 94 %); it serves to check a
 #: named mass error (``describe(lf, DICTIONARY + (inertial,))``).
-DICTIONARY = (odd_in_z, even_in_z, friction, damping, periodic_in_z, drift, line, loop,
-              friction_on_ground, loop_on_ground, stick_slip_on_ground)
+DICTIONARY = (odd_in_z, even_in_z, friction, damping, periodic_in_z, drift, line,
+              drifting_friction, loop, friction_on_ground, loop_on_ground, stick_slip_on_ground)
 
 
 def beyond_uncertainty(lf: LatentForce) -> bool:
@@ -392,13 +434,52 @@ def beyond_uncertainty(lf: LatentForce) -> bool:
     return bool(ratio > SIGNAL_RATIO)
 
 
+#: Bins of the 2x zero-padded spectrum averaged in :func:`determined` (0.55 Hz over 29 s).
+DETERMINED_BINS = 32
+
+
+def _moving_mean(x: np.ndarray, width: int) -> np.ndarray:
+    return np.convolve(x, np.ones(width) / width, mode="same")
+
+
+def determined(lf: LatentForce) -> tuple[LatentForce, Callable]:
+    """(the latent force seen through its determined band, that band's filter): the
+    frequencies where the force's posterior mean stands out of its draws' spread (smoothed
+    power of the mean above that of the draws' deviations, SIGNAL_RATIO), the rest removed
+    from the force and from every shape's bases (zero-padded FFT; after the likelihood's
+    band). From z'' a slow force is amplified by (f_n / f)^2 out of small residuals: on a
+    record with 50 Hz mains hum on the sensor (0.90 N as a force), 78 % of the posterior
+    mean's power lay at 0.5-2 Hz, with the draws' spread as large, and the line found was
+    0.87 Hz; in the determined band it is 50.0 Hz, 0.88 N. Without draws: unchanged."""
+    if lf.draws.ndim != 2 or lf.draws.shape[0] < 2:
+        return lf, lf.band
+    n = lf.force.size
+    nfft = 2 * n
+    spread = np.mean(np.abs(np.fft.rfft(lf.draws - lf.force, nfft, axis=1)) ** 2, axis=0)
+    power = np.abs(np.fft.rfft(lf.force - lf.force.mean(), nfft)) ** 2
+    keep = (_moving_mean(power, DETERMINED_BINS)
+            > SIGNAL_RATIO * _moving_mean(spread, DETERMINED_BINS)).astype(float)
+    if keep.all():
+        return lf, lf.band
+    band = lf.band
+
+    def through(x: np.ndarray) -> np.ndarray:
+        return np.fft.irfft(np.fft.rfft(band(x), nfft, axis=-1) * keep, nfft, axis=-1)[..., :n]
+
+    seen = copy.copy(lf)
+    seen.band = through  # the shapes read the band from here (an instance attribute)
+    return seen, through
+
+
 def describe(lf: LatentForce, dictionary=DICTIONARY) -> ShapeDescription:
     """Every shape of ``dictionary`` fitted to the missing force less its mean (a constant
-    force, a preload or a sensor's offset, is stated apart), best first (a shape later in
-    the dictionary goes first only if it explains SHARE_MARGIN more), and the sentence."""
+    force, a preload or a sensor's offset, is stated apart) within its determined band
+    (:func:`determined`), best first (a shape later in the dictionary goes first only if it
+    explains SHARE_MARGIN more), and the sentence."""
     offset = float(np.mean(lf.force))
-    f = lf.force - offset
-    fitted = [shape(lf, f) for shape in dictionary]
+    seen, through = determined(lf)
+    f = through(lf.force - offset) if seen is not lf else lf.force - offset
+    fitted = [shape(seen, f) for shape in dictionary]
     ranked = sorted(fitted, key=lambda s: -s.share)
     best = next(s for s in fitted if s.share >= ranked[0].share - SHARE_MARGIN)
     ranked = [best] + [s for s in ranked if s is not best]
