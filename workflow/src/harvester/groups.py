@@ -106,6 +106,21 @@ def _sidecar_text(known: Mapping[str, float], priors: Mapping, filtered_at: floa
     return head + (yaml.safe_dump(body, sort_keys=False) if body else "")
 
 
+def _cutoff(first, given, sidecar, lowpass_hz: float | None) -> tuple[float | None, str]:
+    """(low-pass the recording went through, Hz or None; where that is from): the workflow's,
+    unless the sidecar's is lower; else the sidecar's; else found in the output's spectrum."""
+    from harvester.diagnosis.spectral import filter_cutoff
+    if lowpass_hz:
+        if given.filtered_at_hz is not None and given.filtered_at_hz < float(lowpass_hz):
+            return given.filtered_at_hz, "the sidecar (below the workflow's low-pass)"
+        return float(lowpass_hz), "the workflow's zero-phase low-pass (config)"
+    if given.filtered_at_hz is not None:
+        return given.filtered_at_hz, f"the sidecar {sidecar}"
+    found = filter_cutoff(first.data[first.kinds.output_kind].to_numpy(float), 1.0 / first.dt)
+    return found, ("found from the output's spectrum" if found else
+                   "none given, none found in the output's spectrum")
+
+
 def prepare_recording(source: str | Path, sidecar: str | Path | None, out_csv: str | Path,
                       lowpass_hz: float | None = None, filter_order: int = 8,
                       name: str | None = None) -> dict[str, Any]:
@@ -124,23 +139,13 @@ def prepare_recording(source: str | Path, sidecar: str | Path | None, out_csv: s
     """
     from harvester.data.daq import read_checked_recording, sha256
     from harvester.data.sidecar import Sidecar, sidecar_path
-    from harvester.diagnosis.spectral import filter_cutoff
 
     source, out_csv = Path(source), Path(out_csv)
     name = name or out_csv.stem
     given = read_sidecar_file(sidecar) if sidecar else Sidecar(Path("<none>"))
     first = read_checked_recording(source, known=given.known,
                                    known_from=str(sidecar) if sidecar else "no sidecar")
-    if lowpass_hz:
-        cutoff, where = float(lowpass_hz), "the workflow's zero-phase low-pass (config)"
-        if given.filtered_at_hz is not None and given.filtered_at_hz < cutoff:
-            cutoff, where = given.filtered_at_hz, "the sidecar (below the workflow's low-pass)"
-    elif given.filtered_at_hz is not None:
-        cutoff, where = given.filtered_at_hz, f"the sidecar {sidecar}"
-    else:
-        found = filter_cutoff(first.data[first.kinds.output_kind].to_numpy(float), 1.0 / first.dt)
-        cutoff, where = found, ("found from the output's spectrum" if found else
-                                "none given, none found in the output's spectrum")
+    cutoff, where = _cutoff(first, given, sidecar, lowpass_hz)
     notes = [f"{name}: sidecar written by the workflow (rule prepare_recording) from "
              + (str(sidecar) if sidecar else "no sidecar"),
              f"filtered_at_hz: {where}"]

@@ -95,13 +95,6 @@ def _form(df: pd.DataFrame, known: Mapping[str, float], form: str, source: str
     return out, k
 
 
-def _mode(df, known, structure, priors_of, settings, source, temper=1.0, specs=None):
-    """(analysis, posterior mode) of one form: priors from ``priors_of(df, known)``."""
-    a = prepare(df, None, structure, known, settings, source)
-    priors = priors_of(df, known) if specs is None else specs(a, priors_of(df, known))
-    return a, fit_map(a.chain(a.fit_raw, temper), priors, seed=settings.seed)
-
-
 def choose_topology(df: pd.DataFrame, known: Mapping[str, float], baseline: str,
                     priors_of, settings: DiagnosisSettings, source: str = "<recording>"
                     ) -> TopologyChoice:
@@ -118,16 +111,19 @@ def choose_topology(df: pd.DataFrame, known: Mapping[str, float], baseline: str,
         dt = uniform_step(df["time"].to_numpy(dtype=float), source)
         settings = replace(settings, lowpass_hz=filter_cutoff(
             df["rel_disp"].to_numpy(dtype=float), 1.0 / dt))
-    first = {f: _mode(*forms[f], s, priors_of, settings, source) for f in FORMS}
-    temper = min(estimate_temper(mp.residual, a.fit_window, a.fs, a.f_high)
-                 for a, mp in first.values())
-    sigma = max(float(mp.theta[-1]) for _, mp in first.values())
-
-    def specs(a, priors):
-        return {**default_priors(a.structure, sigma, a.fit_raw.output_type.unit), **priors}
-
-    ev = {f: _mode(*forms[f], s, priors_of, settings, source, temper, specs)[1]
-          .log_evidence_laplace for f in FORMS}
+    # per form: its analysis and priors, once; the mode at lambda = 1 sets lambda and sigma
+    prepared = {f: (prepare(forms[f][0], None, s, forms[f][1], settings, source),
+                    priors_of(*forms[f])) for f in FORMS}
+    first = {f: fit_map(a.chain(a.fit_raw, 1.0), pr, seed=settings.seed)
+             for f, (a, pr) in prepared.items()}
+    temper = min(estimate_temper(first[f].residual, a.fit_window, a.fs, a.f_high)
+                 for f, (a, _) in prepared.items())
+    sigma = max(float(mp.theta[-1]) for mp in first.values())
+    ev = {}
+    for f, (a, pr) in prepared.items():  # one likelihood: the same lambda and noise prior
+        specs = {**default_priors(a.structure, sigma, a.fit_raw.output_type.unit), **pr}
+        ev[f] = fit_map(a.chain(a.fit_raw, temper), specs, seed=settings.seed,
+                        start=first[f].theta[:-1]).log_evidence_laplace
     threshold = settings.confirmation().base_threshold
     lead = ev["ground"] - ev["base"]
     chosen = "ground" if lead > threshold else "base"

@@ -189,7 +189,7 @@ def identification_priors(df: pd.DataFrame, free: tuple[str, ...],
     """
     from harvester.data.recording import recording_kinds
     from harvester.data.signals import sampling_rate
-    from harvester.inference.priors import default_prior, recording_scale
+    from harvester.inference.priors import default_prior
     from harvester.initial.frf import initial_priors, sigma_prior
     from harvester.study.paper import TABLE1
 
@@ -218,20 +218,30 @@ def identification_priors(df: pd.DataFrame, free: tuple[str, ...],
                          f"{p} = {fit.values[p]:.4g}" for p in base) + ")")
     specs["sigma"] = sigma_prior(df)
     rest = [p for p in free if p not in specs]
-    device = recording_scale(df, values, lowpass_hz, source=source) if rest else None
-    specs.update({p: default_prior(p) if device is None else default_prior(p, device)
-                  for p in rest})
     if rest:
-        notes.append(f"priors of {', '.join(rest)}: the library's, " + (
-            "on the paper's rig (an acceleration output gives no trusted z)" if device is None
-            else f"on the recording's scale (RMS z {device.z:.3g} m, v {device.v:.3g} m/s; "
-                 f"k {device.k:.3g} N/m)"))
+        defaults, note = _term_defaults(df, rest, values, lowpass_hz, source)
+        specs.update(defaults)
+        notes.append(note)
     for name, entry in (given or {}).items():
         unit = specs[name].unit if name in specs else default_prior(name).unit
         specs[name] = prior_spec(name, {"unit": unit, **entry}, TABLE1)
     if given:
         notes.append(f"priors of {', '.join(given)}: given in the sidecar")
     return specs, notes
+
+
+def _term_defaults(df: pd.DataFrame, names: list[str], values: Mapping[str, float],
+                   lowpass_hz: float | None, source: str) -> tuple[dict[str, PriorSpec], str]:
+    """(priors, note) of the terms' parameters ``names``: the library's, read on the
+    recording's own scale where its output is a displacement (``recording_scale``; ``values``:
+    M, m, k known or fitted), else on the paper's rig."""
+    from harvester.inference.priors import default_prior, recording_scale
+    device = recording_scale(df, values, lowpass_hz, source=source)
+    specs = {p: default_prior(p) if device is None else default_prior(p, device) for p in names}
+    return specs, f"priors of {', '.join(names)}: the library's, " + (
+        "on the paper's rig (an acceleration output gives no trusted z)" if device is None
+        else f"on the recording's scale (RMS z {device.z:.3g} m, v {device.v:.3g} m/s; "
+             f"k {device.k:.3g} N/m)")
 
 
 def diagnosis_priors(df: pd.DataFrame, baseline: str, known: Mapping[str, float],
