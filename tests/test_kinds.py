@@ -151,14 +151,21 @@ def test_a_linear_recording_with_an_impossible_mass_ratio_is_still_an_error() ->
 
 @pytest.mark.skipif(not FRAME.is_dir(), reason="no data/public/marino-frame")
 def test_the_frame_with_its_friction_on_the_ground_is_a_force_input() -> None:
-    """M x'' + C x' + K x + F_f(x') = K y + C y': force -> rel_disp (x), every friction term
-    then acting on x'; it passes the checks (the lasers' common noise above 10 Hz is
-    filtered out)."""
+    """M x'' + C x' + K x + F_f(x') = K y + C y' as kinds.on_ground writes it: force K y
+    (the C y' part left to c_m) -> rel_disp x = z + y, every friction term then acting on x',
+    exactly the base form rewritten; it passes the checks (the lasers' common noise above
+    10 Hz is filtered out)."""
     from harvester.data.public import FRAME_LOWPASS_HZ, marino_frame
     rec = marino_frame(FRAME, 450, friction_on="ground")
+    base = marino_frame(FRAME, 450).data
     assert list(rec.data.columns) == ["time", "force", "rel_disp"]
     assert rec.sidecar == {"M": 3.0799, "k": 1191.0, "filtered_at_hz": FRAME_LOWPASS_HZ}
     assert 1.0 < rec.data.force.std() < 2.0  # N: K y with y about 1.3 mm RMS
+    np.testing.assert_allclose(rec.data.force, 1191.0 * base.base_disp, rtol=0, atol=1e-12)
+    x = base.rel_disp + base.base_disp
+    np.testing.assert_allclose(rec.data.rel_disp, x - x.mean(), rtol=0, atol=1e-15)
+    assert any("on_ground" in n for n in rec.notes) and not any("C y' part RMS" in n
+                                                                for n in rec.notes)
     kinds = RecordingKinds("force", "rel_disp")
     assert checks.check_recording(rec.data, kinds, 0.004, "frame", rec.sidecar,
                                   lowpass_hz=rec.sidecar["filtered_at_hz"]) == []
@@ -234,7 +241,8 @@ def test_the_silverbox_reads_in_volts() -> None:
     from harvester.data.public import silverbox
     rec = silverbox(SILVERBOX, samples=4096)
     assert list(rec.data.columns) == ["time", "force", "rel_disp"] and len(rec.data) == 4096
-    assert rec.sidecar == {} and "VOLTS" in rec.notes[0]
+    assert rec.sidecar == {"units": {"force": "V", "displacement": "V"}}
+    assert "VOLTS" in rec.notes[0]
     assert 1.0 / np.mean(np.diff(rec.data.time)) == pytest.approx(610.35, abs=0.01)
     found = checks.check_recording(rec.data, RecordingKinds("force", "rel_disp"),
                                    1.0 / 610.3515625, "sb", rec.sidecar)

@@ -481,7 +481,9 @@ def predict_command(args: argparse.Namespace) -> int:
     return 0
 
 
-def _diagnosis_settings(args: argparse.Namespace, lowpass: float | None):
+def _diagnosis_settings(args: argparse.Namespace, lowpass: float | None, units=None):
+    """The command's DiagnosisSettings; ``units``: the sidecar's (None: N and m)."""
+    from harvester.data.units import SI
     from harvester.diagnosis import DiagnosisSettings
     _quiet_pymc()
     overrides = {k: v for k, v in {"particles": args.particles, "rounds": args.rounds,
@@ -489,7 +491,8 @@ def _diagnosis_settings(args: argparse.Namespace, lowpass: float | None):
     if args.candidates:
         overrides["candidates"] = tuple(args.candidates)
     overrides.update(chains=args.chains, seed=args.seed, lowpass_hz=lowpass,
-                     filter_order=args.filter_order, figures=not args.no_figures)
+                     filter_order=args.filter_order, figures=not args.no_figures,
+                     units=units or SI)
     return DiagnosisSettings.fast(**overrides) if args.fast else DiagnosisSettings(**overrides)
 
 
@@ -561,7 +564,7 @@ def diagnose_command(args: argparse.Namespace) -> int:
 
     check_output_dir(args.out, inputs=tuple(p for p in (args.recording, args.validation) if p))
     df, validation, lowpass, known, sidecar, notes = _diagnosis_inputs(args)
-    settings = _diagnosis_settings(args, lowpass)
+    settings = _diagnosis_settings(args, lowpass, sidecar.units)
     check_recording(df, str(args.recording), settings.lead_in_s,
                     0.0 if validation is not None else settings.holdout_fraction)
     df, validation, known, form_notes = _friction_form(args, df, validation, known, sidecar,

@@ -95,13 +95,17 @@ def read_sidecar_file(path: str | Path):
 
 
 def _sidecar_text(known: Mapping[str, float], priors: Mapping, filtered_at: float | None,
-                  notes: Sequence[str]) -> str:
+                  notes: Sequence[str], units: Mapping[str, str] | None = None) -> str:
+    """The prepared recording's sidecar: ``known``, ``priors``, ``filtered_at_hz`` (Hz) and
+    ``units`` (the given sidecar's, left out when N and m), ``notes`` as comments."""
     import yaml
     body: dict[str, Any] = dict(known)
     if priors:
         body["priors"] = {k: dict(v) for k, v in priors.items()}
     if filtered_at is not None:
         body["filtered_at_hz"] = float(filtered_at)
+    if units:
+        body["units"] = dict(units)
     head = "".join(f"# {n}\n" for n in notes)
     return head + (yaml.safe_dump(body, sort_keys=False) if body else "")
 
@@ -130,7 +134,8 @@ def prepare_recording(source: str | Path, sidecar: str | Path | None, out_csv: s
     The sidecar written is the sheet's (``sidecar``, or none) with ``filtered_at_hz``: the
     workflow's own low-pass (``lowpass_hz``, applied before: rule ``lowpass``), else the
     sheet sidecar's, else the cut-off found from the output's spectrum
-    (``diagnosis.spectral.filter_cutoff``), else none; every later step reads it from there.
+    (``diagnosis.spectral.filter_cutoff``), else none; every later step reads it from there,
+    and the sheet sidecar's ``units`` where not N and m (the diagnosis's labels).
     Both files appear only when the checks pass (DataError naming the file otherwise). A
     sidecar's ``friction_on: ground`` rewrites the recording in absolute coordinates
     (``data.kinds.on_ground``), so that every later step fits the device's own form; the
@@ -161,7 +166,8 @@ def prepare_recording(source: str | Path, sidecar: str | Path | None, out_csv: s
             shutil.copyfile(source, csv)
         else:
             rewritten.to_csv(csv, index=False, float_format="%.10g")
-        sidecar_path(csv).write_text(_sidecar_text(known, given.priors, cutoff, notes))
+        sidecar_path(csv).write_text(_sidecar_text(known, given.priors, cutoff, notes,
+                                                   given.units.to_sidecar()))
         checked = read_checked_recording(csv, known_from="its sidecar")
         os.replace(sidecar_path(csv), sidecar_path(out_csv))
         os.replace(csv, out_csv)
@@ -310,7 +316,8 @@ def diagnose_model(data: str | Path, validation: str | Path | None, posterior: s
     first validation recording (if any) for the before/after comparison; the window is the
     group's (``window_samples``; without a validation recording the whole record, whose last
     quarter the diagnosis holds out: the group's ``fit_seconds`` should leave it unfitted),
-    the settings config ``diagnosis`` (``DiagnosisSettings``), the low-pass the sidecar's.
+    the settings config ``diagnosis`` (``DiagnosisSettings``), the low-pass and the units
+    the sidecar's.
     Writes diagnosis.json and its figures in ``out_dir``."""
     import arviz as az
 
@@ -330,7 +337,8 @@ def diagnose_model(data: str | Path, validation: str | Path | None, posterior: s
         read_checked_recording(validation, known=known, known_from=str(priors_file)).data
     diag_settings = replace(DiagnosisSettings.from_config(settings["diagnosis"]),
                             lowpass_hz=checked.sidecar.filtered_at_hz,
-                            filter_order=int(settings["filter_order"]))
+                            filter_order=int(settings["filter_order"]),
+                            units=checked.sidecar.units)
     lead_in, samples = window_samples(settings, 1.0 / checked.dt)
     if unseen is None:  # the diagnosis holds out the record's end, which no fit has seen
         samples = None

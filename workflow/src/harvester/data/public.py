@@ -14,7 +14,9 @@ sidecar (``harvester.data.sidecar``) its source gives, with what was done said i
 * :func:`silverbox`: the Silverbox electronic Duffing oscillator (Wigren and Schoukens 2013):
   input V1 (a force, in volts) -> ``force``, output V2 (a displacement, in volts) ->
   ``rel_disp``, each about its mean (their offsets are measurement errors); M, m, k unknown,
-  so no sidecar values: the values are volts, not N and m. :func:`silverbox_heldout` cuts
+  so no device values: the values are volts, not N and m, which the sidecar's
+  ``units: {force: V, displacement: V}`` says (:data:`SILVERBOX_UNITS`; the diagnosis labels
+  its sizes with them, ``harvester.data.units``). :func:`silverbox_heldout` cuts
   it into samples to fit and samples held out after them (a simulation-error test).
 
 The shared data directory's SOURCE.md files give the provenance.
@@ -34,8 +36,6 @@ from harvester.data.signals import lowpass
 #: The frame's device (Marino and Cicirello 2023, initial estimates): M z'' + C z' + K z
 #: + F_f = -M y'' with z = x - y, so m = M.
 FRAME_DEVICE = {"M": 3.0799, "m": 3.0799, "k": 1191.0}
-#: The frame's viscous damping C (N s/m, the authors' initial estimate).
-FRAME_DAMPING = 0.669
 #: Zero-phase low-pass (Hz, order 8) of both frame channels: above 10 Hz they hold sensor
 #: noise only (SOURCE.md), and that noise is common to both lasers: with a 20 Hz low-pass the
 #: storey's absolute x follows F = K y at 9.5-15.5 Hz with 17.9 times the gain a passive mass
@@ -54,6 +54,8 @@ SILVERBOX_BENCHMARK_TESTS = (
     "its first 32000 samples: the arrow without the extrapolation",
     "the last 25 % of SNLS80mV.mat samples 40650-127400 (the loader's multisine test; the "
     "first 75 % are its training and validation data)")
+#: The Silverbox's units (its sidecar's ``units``): both channels in volts.
+SILVERBOX_UNITS = {"force": "V", "displacement": "V"}
 #: Silverbox sampling rate (Hz): 1e7 / 2^14.
 SILVERBOX_FS = 1e7 / 2**14
 #: First sample of its periodic multisine (SOURCE.md).
@@ -71,7 +73,7 @@ class PublicRecording:
 
     def write(self, csv_path: str | Path) -> Path:
         """The recording as ``csv_path`` and its sidecar beside it (``.yaml``, the notes as
-        comments; written also when the source gives no values, so that it says so)."""
+        comments; written also when the source gives no device values, so that it says so)."""
         import yaml
 
         from harvester.data.daq import write_recording
@@ -80,8 +82,9 @@ class PublicRecording:
         csv_path.parent.mkdir(parents=True, exist_ok=True)
         write_recording(self.data, csv_path)
         head = "".join(f"# {line}\n" for line in self.notes)
-        body = yaml.safe_dump(self.sidecar, sort_keys=False) if self.sidecar else \
-            "# no device values: its source gives none in SI units\n"
+        if not {"M", "m", "k"} & set(self.sidecar):
+            head += "# no device values: its source gives none in SI units\n"
+        body = yaml.safe_dump(self.sidecar, sort_keys=False) if self.sidecar else ""
         sidecar_path(csv_path).write_text(head + body)
         return csv_path
 
@@ -110,11 +113,13 @@ def marino_frame(directory: str | Path, load_g: int, friction_on: str = "base"
 
     ``friction_on``: "base" (as recorded: base_disp -> rel_disp, the library's friction
     terms then act on the velocity relative to the base) or "ground", the frame's own
-    topology (its contact is fixed to the ground): the storey's equation in absolute
-    coordinates, M x'' + C x' + K x + F_f(x') = K y + C y', is eq. (1) driven by the force
-    F = K y + C y' (N, the authors' K and C, :data:`FRAME_DAMPING`) with the output x (m, the
-    storey's displacement about its mean), so that every friction term acts on x'. The
-    model's k must then be the K that made F (the sidecar gives it) and its c_m stands for C.
+    topology (its contact is fixed to the ground): that same base form rewritten by
+    :func:`harvester.data.kinds.on_ground`, the one place of that rewrite. The storey's
+    equation in absolute coordinates, M x'' + C x' + K x + F_f(x') = K y + C y', becomes eq.
+    (1) driven by the force F = K y (N, K the authors' 1191 N/m) with the output x = z + y (m,
+    about its mean), so that every friction term acts on x'; the C y' part (C 0.669 N s/m,
+    the authors' estimate) is left out of F, as the model's c_m is identified. The model's k
+    must then be the K that made F (the sidecar gives it; m is dropped, M = m).
     """
     directory = Path(directory)
     xf, yf = (directory / f"s_b_{load_g}g_{c}.mat" for c in ("x", "y"))
@@ -129,28 +134,19 @@ def marino_frame(directory: str | Path, load_g: int, friction_on: str = "base"
     base, rel = (lowpass(c, fs, FRAME_LOWPASS_HZ, FRAME_FILTER_ORDER) for c in (base, rel))
     if friction_on not in ("base", "ground"):
         raise ValueError(f"friction_on must be 'base' or 'ground', got {friction_on!r}")
-    if friction_on == "ground":
-        from harvester.data.kinds import derivative
-        cut = FRAME_LOWPASS_HZ
-        base = lowpass(y["y"] / 1000.0, fs, cut, FRAME_FILTER_ORDER)
-        storey = lowpass(x["x"] / 1000.0, fs, cut, FRAME_FILTER_ORDER)
-        y_vel = derivative(base, 1.0 / fs, 1, cut)
-        force = FRAME_DEVICE["k"] * (base - base.mean()) + FRAME_DAMPING * y_vel
-        data = pd.DataFrame({"time": t, "force": force, "rel_disp": storey - storey.mean()})
-        notes = [f"{xf.name}, {yf.name}: x, y (mm, low-passed at {cut:g} Hz, "
-                 "zero phase) -> the frame with its friction on the ground: force = K y + C y' "
-                 f"(K {FRAME_DEVICE['k']:g} N/m, C {FRAME_DAMPING:g} N s/m, the authors'; the "
-                 f"C y' part RMS {FRAME_DAMPING * np.std(y_vel):.3g} N of "
-                 f"{np.std(force):.3g} N), rel_disp = x (m, about its mean, relative to the "
-                 f"ground); time from 0 (the file's starts at {x['t'][0]:g} s)"]
-        sidecar = {"M": FRAME_DEVICE["M"], "k": FRAME_DEVICE["k"], "filtered_at_hz": cut}
-        return PublicRecording(data, sidecar, notes)
     data = pd.DataFrame({"time": t, "base_disp": base - base.mean(),
                          "rel_disp": rel - rel.mean()})
     notes = [f"{xf.name}, {yf.name}: x, y (mm) -> base_disp = y, rel_disp = x - y (m), each "
              f"low-passed at {FRAME_LOWPASS_HZ:g} Hz (order {FRAME_FILTER_ORDER}, zero phase) "
              f"and taken about its mean; time from 0 (the file's starts at {x['t'][0]:g} s)"]
     sidecar = {**FRAME_DEVICE, "filtered_at_hz": FRAME_LOWPASS_HZ}
+    if friction_on == "ground":
+        from harvester.data.kinds import on_ground
+        data, known, done = on_ground(data, FRAME_DEVICE, f"{xf.name}, {yf.name}")
+        notes += [f"friction_on='ground' (marino_frame's argument, not a sidecar): the "
+                  "recording above rewritten by harvester.data.kinds.on_ground (the C y' part "
+                  "of the storey's drive left out, the model's c_m identified)"] + done
+        sidecar = {**known, "filtered_at_hz": FRAME_LOWPASS_HZ}
     return PublicRecording(data, sidecar, notes)
 
 
@@ -168,9 +164,9 @@ def silverbox(path: str | Path, start: int = SILVERBOX_START,
     data = pd.DataFrame({"time": np.arange(n) / SILVERBOX_FS, "force": u[start:stop],
                          "rel_disp": y[start:stop]})
     notes = [f"{path.name}: V1 -> force, V2 -> rel_disp, in VOLTS (the circuit's M, m, k are "
-             f"not known in SI), each about its mean over the file; samples {start}-{stop} at "
-             f"{SILVERBOX_FS:.6g} Hz"]
-    return PublicRecording(data, {}, notes)
+             f"not known in SI; units: force V, displacement V), each about its mean over the "
+             f"file; samples {start}-{stop} at {SILVERBOX_FS:.6g} Hz"]
+    return PublicRecording(data, {"units": dict(SILVERBOX_UNITS)}, notes)
 
 
 @dataclass(frozen=True)

@@ -16,6 +16,10 @@ friction_on           ``base`` or ``ground``: what the device's friction acts on
                       ``harvester.data.kinds.on_ground`` writes such a recording. Not
                       given: relative to the base, except where ``harvester diagnose``
                       can compare both (``harvester.diagnosis.topology``)
+units                 ``{force: UNIT, displacement: UNIT}``: the units of a recording not
+                      in N and m (a circuit's volts: ``{force: V, displacement: V}``);
+                      only the diagnosis's labels follow them (``harvester.data.units``);
+                      not given: N and m
 ============== ====== ===================================================================
 
 Parameters the sidecar does not give are identified where the method can (``harvester
@@ -33,6 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from harvester.data.errors import DataError
+from harvester.data.units import SI, Units, read_units
 
 log = logging.getLogger("harvester.data.sidecar")
 
@@ -41,6 +46,7 @@ SIDECAR_KEYS: dict[str, str] = {
     "M": "effective mass (kg)", "m": "oscillating mass (kg)", "k": "stiffness (N/m)",
     "priors": "{parameter: {mean, sd}}", "filtered_at_hz": "low-pass already applied (Hz)",
     "friction_on": "base or ground (what the friction acts on)",
+    "units": "{force: UNIT, displacement: UNIT} where not N and m",
 }
 #: Device parameters a sidecar may give, with their units.
 DEVICE_PARAMETERS: dict[str, str] = {"M": "kg", "m": "kg", "k": "N/m"}
@@ -56,12 +62,13 @@ class Sidecar:
     priors: dict[str, dict[str, float]] = field(default_factory=dict)
     filtered_at_hz: float | None = None
     friction_on: str | None = None  # None: not stated (relative to the base unless compared)
+    units: Units = SI  # the force's and the displacement's units (default N, m)
 
     def summary(self) -> dict[str, Any]:
         """For run.json: where it is and what it gave."""
         return {"path": str(self.path), "found": self.found, "known": dict(self.known),
                 "priors": dict(self.priors), "filtered_at_hz": self.filtered_at_hz,
-                "friction_on": self.friction_on}
+                "friction_on": self.friction_on, "units": self.units.to_sidecar()}
 
 
 def sidecar_path(recording: str | Path) -> Path:
@@ -111,7 +118,8 @@ def read_sidecar(recording: str | Path) -> Sidecar:
     """Read and check the sidecar beside ``recording`` (none: an empty Sidecar).
 
     DataError (file and line) for invalid YAML, a non-mapping, an unknown key, a value that
-    is not a positive number, malformed priors, or m > M (M = m + J (2 pi / l)^2 >= m).
+    is not a positive number, malformed priors, malformed units (``units.read_units``), or
+    m > M (M = m + J (2 pi / l)^2 >= m).
     """
     import yaml
     path = sidecar_path(recording)
@@ -148,7 +156,7 @@ def read_sidecar(recording: str | Path) -> Sidecar:
     return Sidecar(path, True, known, _priors(path, meta.get("priors", {}), lines.get("priors")),
                    None if cutoff is None else _positive(path, "filtered_at_hz", cutoff,
                                                          lines.get("filtered_at_hz")),
-                   friction_on)
+                   friction_on, read_units(path, meta.get("units"), lines.get("units")))
 
 
 @dataclass(frozen=True)

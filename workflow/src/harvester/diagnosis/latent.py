@@ -39,6 +39,7 @@ import numpy as np
 from scipy import optimize
 
 from harvester.data.signals import lowpass
+from harvester.data.units import SI, Units
 from harvester.diagnosis.baseline import BaselineState
 from harvester.diagnosis.state_space import (MATERN_STATES, backward_sample, discretise,
                                              kalman_filter, kalman_loglik, matern,
@@ -84,6 +85,8 @@ class LatentForce:
     draws: np.ndarray = field(repr=False, default_factory=lambda: np.empty((0, 0)))
     #: joint draws of (z, z', z'') along the window, (3, draws, samples), SI units
     state_draws: np.ndarray = field(repr=False, default_factory=lambda: np.empty((3, 0, 0)))
+    #: the recording's units (``data.units``): "N" and "m" above stand for them
+    units: Units = SI
 
     @property
     def lower(self) -> np.ndarray:
@@ -116,7 +119,8 @@ class LatentForce:
                 "kernel": self.kernel, "length_scale_s": self.length_scale_s,
                 "amplitude_N": self.amplitude_N, "noise_sd": self.noise_sd,
                 "baseline_noise_sd": self.baseline_noise_sd, "log_marginal": self.log_marginal,
-                "band_hz": self.band_hz, "stride": self.stride, "seconds": self.seconds}
+                "band_hz": self.band_hz, "stride": self.stride, "seconds": self.seconds,
+                "force_unit": self.units.label("force")}
 
 
 @dataclass

@@ -6,11 +6,12 @@ effect's force beside it with its size and relevance (``relevance``), and the fi
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
+from harvester.data.units import SI, Units
 from harvester.diagnosis.baseline import BaselineState
 from harvester.diagnosis.latent import LatentForce, latent_force
 from harvester.diagnosis.latent_views import Binned, EffectForce, effect_force, views
@@ -54,11 +55,13 @@ class MissingForce:
 def missing_force(state: BaselineState, window: tuple[int, int] | None = None,
                   named: Sequence[NamedEffect] = (), unseen_input: np.ndarray | None = None,
                   unseen_window: slice | None = None, floor: RelevanceFloor = RelevanceFloor(),
-                  out_dir: str | Path | None = None, **latent_kwargs) -> MissingForce:
+                  out_dir: str | Path | None = None, units: Units = SI,
+                  **latent_kwargs) -> MissingForce:
     """Everything of the missing force for a baseline ``state`` (module docstring);
     ``unseen_input`` (the held-out or validation input, ``unseen_window`` of it) gives each
-    named effect's change of the predicted response; figures in ``out_dir`` if given."""
-    lf = latent_force(state, window, **latent_kwargs)
+    named effect's change of the predicted response; ``units``: the recording's (the labels
+    of every size, ``data.units``); figures in ``out_dir`` if given."""
+    lf = replace(latent_force(state, window, **latent_kwargs), units=units)
     desc = describe(lf)
     out = MissingForce(lf, desc, views(lf))
     for effect in named:

@@ -5,7 +5,8 @@ negligible" rather than missing physics.
 
 Sizes, along the latent force's smoothed states (``latent_views.effect_force``):
 
-    force_rms        RMS of dF, the improved model's force beyond the baseline's (N)
+    force_rms        RMS of dF, the improved model's force beyond the baseline's (N, or the
+                     recording's force unit: ``units``, ``data.units``)
     share_of_drive   force_rms / RMS of the drive (m y'' or F): the force that moves the device
     share_of_latent  1 - sum (f - dF)^2 / sum f^2, f the latent (missing) force
     response change  RMS of the improved minus the baseline's predicted output on unseen data,
@@ -24,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from harvester.data.units import SI, Units
 from harvester.diagnosis.latent import LatentForce
 from harvester.diagnosis.latent_views import EffectForce
 from harvester.model.structures import ModelStructure
@@ -54,15 +56,16 @@ class EffectSize:
     response_change_share: float | None
     negligible: bool
     floor: RelevanceFloor
+    units: Units = SI  # the recording's (force_rms_N is in its force unit)
 
     @property
     def label(self) -> str:
         return "detectable but negligible" if self.negligible else "relevant"
 
     def sentence(self) -> str:
-        text = (f"{self.term}: {self.force_rms_N:.3g} N RMS ({100 * self.share_of_drive:.2g} % "
-                f"of the drive), explains {100 * max(self.share_of_latent, 0):.0f} % of the "
-                "missing force")
+        text = (f"{self.term}: {self.force_rms_N:.3g} {self.units.label('force')} RMS "
+                f"({100 * self.share_of_drive:.2g} % of the drive), explains "
+                f"{100 * max(self.share_of_latent, 0):.0f} % of the missing force")
         if self.response_change_share is not None:
             text += (f", changes the predicted response by {100 * self.response_change_share:.2g}"
                      " % RMS on unseen data")
@@ -70,6 +73,7 @@ class EffectSize:
 
     def to_dict(self) -> dict:
         return {"term": self.term, "force_rms_N": self.force_rms_N,
+                "force_unit": self.units.label("force"),
                 "share_of_drive": self.share_of_drive, "share_of_latent": self.share_of_latent,
                 "response_change_rms": self.response_change_rms,
                 "response_change_share": self.response_change_share,
@@ -105,10 +109,11 @@ def response_change(problem, theta: np.ndarray, improved: ModelStructure,
 def effect_size(lf: LatentForce, ef: EffectForce, floor: RelevanceFloor = RelevanceFloor(),
                 response: tuple[float, float] | None = None) -> EffectSize:
     """The named effect's size from its force beside the latent force (``ef``) and, if
-    given, its ``response`` change on unseen data (:func:`response_change`)."""
+    given, its ``response`` change on unseen data (:func:`response_change`); labelled in
+    ``lf.units``."""
     share = ef.rms_N / drive_rms(lf)
     small_response = response is None or response[1] < floor.response_share
     negligible = floor.enabled and share < floor.force_share and small_response
     return EffectSize(ef.term, ef.rms_N, share, ef.share,
                       None if response is None else response[0],
-                      None if response is None else response[1], negligible, floor)
+                      None if response is None else response[1], negligible, floor, lf.units)

@@ -183,7 +183,8 @@ def estimate_missing_force(a: Analysis, state: BaselineState, found: Conclusion,
     try:
         out = missing_force(state, (a.lead, a.hold), named, rec.iloc[:, 1].to_numpy(), window,
                             RelevanceFloor(settings.relevance_share, settings.relevance_share,
-                                           settings.relevance_share > 0))
+                                           settings.relevance_share > 0),
+                            units=settings.units)
     # a coupling term (backlash) has no force on the mass alone (term_forces); a model that
     # cannot be simulated at its posterior mean or on the unseen input (latent, relevance);
     # a smoother whose covariance is not positive definite: each leaves the diagnosis without

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+from harvester.data.units import SI, Units, read_units
 from harvester.diagnosis.confirm import ConfirmSettings
 from harvester.diagnosis.detect import DetectionSettings
 
@@ -45,7 +46,8 @@ class DiagnosisSettings:
     a model whose two chains disagree by more than a nat is sampled again with twice the
     particles. denoise_input: drive the models with the base acceleration without its
     bins on the channel's noise floor, where it shows one (``data.input_noise``); False: as
-    recorded.
+    recorded. units: the recording's force and displacement units (the sidecar's ``units``,
+    ``data.units``; default N and m): the labels of every size the diagnosis writes.
     """
 
     particles: int = ConfirmSettings.particles
@@ -75,6 +77,7 @@ class DiagnosisSettings:
     figures: bool = True
     reference_start: bool = ConfirmSettings.reference
     denoise_input: bool = True
+    units: Units = SI
 
     @classmethod
     def fast(cls, **overrides) -> "DiagnosisSettings":
@@ -114,6 +117,8 @@ class DiagnosisSettings:
             raise ValueError(f"diagnosis settings: unknown key(s) {unknown}")
         values = {k: (tuple(v) if k == "candidates" and v is not None else v)
                   for k, v in cfg.items() if k != "fast"}
+        if "units" in values:  # a mapping, as a sidecar's
+            values["units"] = read_units("diagnosis settings", values["units"])
         return cls.fast(**values) if cfg.get("fast") else cls(**values)
 
     def detection(self) -> DetectionSettings:

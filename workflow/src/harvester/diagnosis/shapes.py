@@ -8,7 +8,10 @@ and the best one said in one sentence ("a force periodic in z, period 3.0 mm, am
 at most one scanned parameter:
 
 The force's mean (a preload, a sensor's offset) is taken out first and stated apart; the
-shares are of what varies.
+shares are of what varies. Units are written for N and m; the sentences label each size in
+the recording's own (``lf.units``, ``data.units``: a circuit's volts say "V", "V/V"), and
+show small displacements in mm only when the displacement is in m; the parameters' names
+keep their SI suffixes (``F_N`` holds volts for a recording in volts).
 
 ``odd in z``        k_1 z + k_3 z^3 + k_5 z^5 (a stiffness error, a hardening spring)
 ``even in z``       f_0 + k_2 z^2 + k_4 z^4 (an offset, an asymmetric spring)
@@ -144,8 +147,9 @@ def odd_in_z(lf: LatentForce, f: np.ndarray) -> Shape:
     _, fitted, share = _fit(f, np.column_stack([x, x**3, x**5]), lf.band)
     coef = _fit(f, np.column_stack([x, x**3]), lf.band)[0]
     k = coef / s ** np.array([1, 3])
-    sentence = (f"a force odd in z (k_1 = {k[0]:.3g} N/m, k_3 = {k[1]:.3g} N/m^3), "
-                f"{_explains(share)}")
+    u = lf.units
+    sentence = (f"a force odd in z (k_1 = {k[0]:.3g} {u.label('N/m')}, k_3 = {k[1]:.3g} "
+                f"{u.label('N/m^3')}), {_explains(share)}")
     return Shape("odd in z", share, {"k1_N_per_m": k[0], "k3_N_per_m3": k[1]}, sentence,
                  fitted)
 
@@ -156,8 +160,9 @@ def even_in_z(lf: LatentForce, f: np.ndarray) -> Shape:
     x = lf.rel_disp / s
     coef, fitted, share = _fit(f, np.column_stack([np.ones_like(x), x**2, x**4]), lf.band)
     k = coef / s ** np.array([0, 2, 4])
-    sentence = (f"a force even in z (offset {k[0]:.3g} N, k_2 = {k[1]:.3g} N/m^2), "
-                f"{_explains(share)}")
+    u = lf.units
+    sentence = (f"a force even in z (offset {k[0]:.3g} {u.label('N')}, k_2 = {k[1]:.3g} "
+                f"{u.label('N/m^2')}), {_explains(share)}")
     return Shape("even in z", share, {"offset_N": k[0], "k2_N_per_m2": k[1],
                                       "k4_N_per_m4": k[2]}, sentence, fitted)
 
@@ -170,9 +175,11 @@ def _sign_law(lf: LatentForce, f: np.ndarray, w: np.ndarray, name: str, what: st
     grid = np.geomspace(1e-3 * sv, sv, SCAN_POINTS)
     v0, coef, fitted, share = _scan(
         f, lambda v: np.column_stack([np.tanh(w / v), lf.rel_vel]), grid, lf.band)
-    sentence = (f"a friction-like force F sgn({what}) of {coef[0]:.3g} N (smoothed over "
-                f"{1e3 * v0:.2g} mm/s; with {coef[1]:.3g} N s/m of viscous damping), "
-                f"{_explains(share)}")
+    u = lf.units
+    scale, vel = u.small("velocity")
+    sentence = (f"a friction-like force F sgn({what}) of {coef[0]:.3g} {u.label('N')} "
+                f"(smoothed over {scale * v0:.2g} {vel}; with {coef[1]:.3g} "
+                f"{u.label('N s/m')} of viscous damping), {_explains(share)}")
     return Shape(name, share, {"F_N": coef[0], "v0_m_per_s": v0, "c_N_s_per_m": coef[1]},
                  sentence, fitted)
 
@@ -212,10 +219,13 @@ def drifting_friction(lf: LatentForce, f: np.ndarray) -> Shape:
             banded = lf.band(basis(v0).T).T
             coef, *_ = np.linalg.lstsq(banded[sure], f[sure], rcond=None)
     span = float(lf.time[-1] - lf.time[0])
-    sentence = (f"a friction-like force F sgn(z') drifting in time, {coef[1]:.3g} N/s (from "
-                f"{coef[0] - 0.5 * span * coef[1]:.3g} N to {coef[0] + 0.5 * span * coef[1]:.3g} "
-                f"N over {span:.3g} s; smoothed over {1e3 * v0:.2g} mm/s, with {coef[2]:.3g} "
-                f"N s/m of viscous damping), {_explains(share)}")
+    u = lf.units
+    force, (scale, vel) = u.label("N"), u.small("velocity")
+    sentence = (f"a friction-like force F sgn(z') drifting in time, {coef[1]:.3g} "
+                f"{u.label('N/s')} (from {coef[0] - 0.5 * span * coef[1]:.3g} {force} to "
+                f"{coef[0] + 0.5 * span * coef[1]:.3g} {force} over {span:.3g} s; smoothed over "
+                f"{scale * v0:.2g} {vel}, with {coef[2]:.3g} {u.label('N s/m')} of viscous "
+                f"damping), {_explains(share)}")
     return Shape("drifting friction", share, {"F_N": coef[0], "slope_N_per_s": coef[1],
                                               "v0_m_per_s": v0, "c_N_s_per_m": coef[2]},
                  sentence, fitted)
@@ -244,8 +254,9 @@ def damping(lf: LatentForce, f: np.ndarray) -> Shape:
     """c z' + c_2 z'|z'| (N s/m, N s^2/m^2)."""
     v = lf.rel_vel
     coef, fitted, share = _fit(f, np.column_stack([v, v * np.abs(v)]), lf.band)
-    sentence = (f"a damping force (c = {coef[0]:.3g} N s/m, c_2 = {coef[1]:.3g} "
-                f"N s^2/m^2), {_explains(share)}")
+    u = lf.units
+    sentence = (f"a damping force (c = {coef[0]:.3g} {u.label('N s/m')}, c_2 = {coef[1]:.3g} "
+                f"{u.label('N s^2/m^2')}), {_explains(share)}")
     return Shape("damping", share, {"c_N_s_per_m": coef[0], "c2_N_s2_per_m2": coef[1]},
                  sentence, fitted)
 
@@ -263,10 +274,11 @@ def periodic_in_z(lf: LatentForce, f: np.ndarray) -> Shape:
     P, coef, fitted, share = _scan(f, lambda p: _pair(2.0 * np.pi * z / p), grid, lf.band)
     amp = float(np.hypot(*coef))
     z_sd = float(np.sqrt(np.mean(lf.disp_sd**2)))
-    caveat = (f" (z is known to +-{1e3 * z_sd:.2g} mm only: the amplitude is a lower bound)"
-              if P < 4.0 * z_sd else "")
-    sentence = (f"a force periodic in z, period {1e3 * P:.3g} mm, amplitude {amp:.3g} N"
-                f"{caveat}, {_explains(share)}")
+    scale, disp = lf.units.small("displacement")
+    caveat = (f" (z is known to +-{scale * z_sd:.2g} {disp} only: the amplitude is a lower "
+              "bound)" if P < 4.0 * z_sd else "")
+    sentence = (f"a force periodic in z, period {scale * P:.3g} {disp}, amplitude {amp:.3g} "
+                f"{lf.units.label('N')}{caveat}, {_explains(share)}")
     return Shape("periodic in z", share, {"period_m": P, "amplitude_N": amp}, sentence,
                  fitted)
 
@@ -275,8 +287,10 @@ def drift(lf: LatentForce, f: np.ndarray) -> Shape:
     """f_0 + s t: a slow change (N, N/s) over the window."""
     t = lf.time - lf.time.mean()
     coef, fitted, share = _fit(f, np.column_stack([np.ones_like(t), t]), lf.band)
-    sentence = (f"a force drifting slowly in time, {coef[1]:.3g} N/s (from {fitted[0]:.3g} N "
-                f"to {fitted[-1]:.3g} N), {_explains(share)}")
+    u = lf.units
+    sentence = (f"a force drifting slowly in time, {coef[1]:.3g} {u.label('N/s')} (from "
+                f"{fitted[0]:.3g} {u.label('N')} to {fitted[-1]:.3g} {u.label('N')}), "
+                f"{_explains(share)}")
     return Shape("drift", share, {"slope_N_per_s": coef[1], "mean_N": coef[0]}, sentence,
                  fitted)
 
@@ -313,7 +327,7 @@ def line(lf: LatentForce, f: np.ndarray) -> Shape:
     span = float(t[-1] - t[0])
     what = (f"a slow change (one period in {1.0 / f0:.3g} s over a {span:.3g} s record)"
             if f0 < 2.0 / span else f"a line at {f0:.4g} Hz")
-    sentence = f"{what}, amplitude {amp:.3g} N, {_explains(share)}"
+    sentence = f"{what}, amplitude {amp:.3g} {lf.units.label('N')}, {_explains(share)}"
     return Shape("line", share, {"frequency_hz": f0, "amplitude_N": amp}, sentence, fitted)
 
 
@@ -370,8 +384,10 @@ def stick_slip_on_ground(lf: LatentForce, f: np.ndarray) -> Shape:
             for vs in np.geomspace(1e-2 * sv, 0.5 * sv, SCAN_POINTS)]
     vs, F, b, fitted, share = max(fits, key=lambda r: r[-1])
     stuck = float(np.mean(_stick_runs(x_vel, vs, shortest) >= 0))
-    sentence = (f"stick and slip on the ground: slides at {F:.3g} N, sticks below "
-                f"{1e3 * vs:.2g} mm/s ({100 * stuck:.0f} % of the time), {_explains(share)}")
+    scale, vel = lf.units.small("velocity")
+    sentence = (f"stick and slip on the ground: slides at {F:.3g} {lf.units.label('N')}, "
+                f"sticks below {scale * vs:.2g} {vel} ({100 * stuck:.0f} % of the time), "
+                f"{_explains(share)}")
     return Shape("stick-slip on the ground", share, {"F_N": F, "v_stick_m_per_s": vs,
                                                      "held_gain": b, "stuck_share": stuck},
                  sentence, fitted)
@@ -391,8 +407,9 @@ def _dahl(lf: LatentForce, f: np.ndarray, w: np.ndarray, name: str, what: str) -
 
     grid = np.geomspace(1e-3 * sz, sz, SCAN_POINTS // 2)
     delta, coef, fitted, share = _scan(f, basis, grid, lf.band)
-    sentence = (f"a hysteresis loop in ({what}, f), {coef[0]:.3g} N at saturation, "
-                f"pre-sliding over {1e3 * delta:.2g} mm, {_explains(share)}")
+    scale, disp = lf.units.small("displacement")
+    sentence = (f"a hysteresis loop in ({what}, f), {coef[0]:.3g} {lf.units.label('N')} at "
+                f"saturation, pre-sliding over {scale * delta:.2g} {disp}, {_explains(share)}")
     return Shape(name, share, {"F_N": coef[0], "delta_m": delta}, sentence, fitted)
 
 
@@ -411,7 +428,8 @@ def inertial(lf: LatentForce, f: np.ndarray) -> Shape:
     cols = [lf.rel_acc] + ([lf.input] if lf.input_kind == "base_acc" else [])
     coef, fitted, share = _fit(f, np.column_stack(cols), lf.band)
     dm = float(coef[1]) if len(coef) > 1 else 0.0
-    sentence = (f"an inertial force (dM = {coef[0]:.3g} kg on z'', dm = {dm:.3g} kg on "
+    mass = lf.units.label("kg")
+    sentence = (f"an inertial force (dM = {coef[0]:.3g} {mass} on z'', dm = {dm:.3g} {mass} on "
                 f"y''), {_explains(share)}")
     return Shape("inertial", share, {"dM_kg": float(coef[0]), "dm_kg": dm}, sentence, fitted)
 
@@ -475,7 +493,7 @@ def describe(lf: LatentForce, dictionary=DICTIONARY) -> ShapeDescription:
     """Every shape of ``dictionary`` fitted to the missing force less its mean (a constant
     force, a preload or a sensor's offset, is stated apart) within its determined band
     (:func:`determined`), best first (a shape later in the dictionary goes first only if it
-    explains SHARE_MARGIN more), and the sentence."""
+    explains SHARE_MARGIN more), and the sentence (sizes in ``lf.units``)."""
     offset = float(np.mean(lf.force))
     seen, through = determined(lf)
     f = through(lf.force - offset) if seen is not lf else lf.force - offset
@@ -483,11 +501,11 @@ def describe(lf: LatentForce, dictionary=DICTIONARY) -> ShapeDescription:
     ranked = sorted(fitted, key=lambda s: -s.share)
     best = next(s for s in fitted if s.share >= ranked[0].share - SHARE_MARGIN)
     ranked = [best] + [s for s in ranked if s is not best]
-    rms, sd = lf.rms_N, float(np.mean(lf.sd))
+    rms, sd, force = lf.rms_N, float(np.mean(lf.sd)), lf.units.label("N")
     if not beyond_uncertainty(lf):
-        sentence = (f"no missing force beyond its uncertainty (RMS {rms:.3g} N against an sd "
-                    f"of {sd:.3g} N)")
+        sentence = (f"no missing force beyond its uncertainty (RMS {rms:.3g} {force} against "
+                    f"an sd of {sd:.3g} {force})")
     else:
-        about = f" about a constant {offset:.3g} N" if abs(offset) > 0.1 * rms else ""
-        sentence = f"{best.sentence}{about} (RMS {rms:.3g} N)"
+        about = f" about a constant {offset:.3g} {force}" if abs(offset) > 0.1 * rms else ""
+        sentence = f"{best.sentence}{about} (RMS {rms:.3g} {force})"
     return ShapeDescription(ranked, rms, sd, sentence, offset)

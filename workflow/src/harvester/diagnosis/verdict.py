@@ -21,6 +21,7 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass, field, replace
 
+from harvester.data.units import SI, Units
 from harvester.diagnosis.confirm import CandidateResult
 from harvester.diagnosis.fits import ModelFit
 from harvester.diagnosis.detect import Detection
@@ -179,7 +180,8 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
     """The verdict with the fit on unseen data, the noise floor and the named effects'
     relevance weighed in (``decide_verdict``), its notes and headline. ``missing``: the
     missing force with each named effect's size (``missing_force``); an accepted effect
-    counts as missing physics only if one of them is relevant."""
+    counts as missing physics only if one of them is relevant. Sizes are labelled in
+    ``settings.units`` (the recording's)."""
     limit = settings.floor_ratio
     above, within = fit.above(limit), fit.within(limit)
     sizes = missing.sizes if missing is not None else []
@@ -211,43 +213,46 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
                      "periods, quiet lead-in or white band): the verdict rests on the "
                      "detection's replicates and on the share of unseen data explained")
     return replace(found, verdict=verdict, unexplained=bool(unexplained), notes=notes, fit=fit,
-                   headline=headline(verdict, found, fit, baseline, limit, missing))
+                   headline=headline(verdict, found, fit, baseline, limit, missing,
+                                     settings.units))
 
 
-def _level(effect: str, fit: ModelFit | None) -> str:
+def _level(effect: str, fit: ModelFit | None, units: Units = SI) -> str:
     """A named effect with what it is, when a friction law, and its fitted strength (the
-    term's probe parameter, posterior mean +- sd, in its unit): "hysteresis (friction, F_hyst
-    0.661 +- 0.0049 N)". A name alone when the improved fit lacks the parameter."""
+    term's probe parameter, posterior mean +- sd, in its unit in ``units``): "hysteresis
+    (friction, F_hyst 0.661 +- 0.0049 N)", "... V" for a recording in volts. A name alone
+    when the improved fit lacks the parameter."""
     from harvester.model.terms import is_friction, term
     t = term(effect)
     what = "friction, " if is_friction(t) else ""
     s = fit.summary().get(t.probe.strength) if fit is not None else None
     if s is None:
         return f"{effect} (friction)" if what else effect
-    unit = {p.name: p.unit for p in t.parameters}[t.probe.strength]
+    unit = units.label({p.name: p.unit for p in t.parameters}[t.probe.strength])
     return (f"{effect} ({what}{t.probe.strength} {s['mean']:.3g} +- {s['sd']:.2g} "
             f"{unit})").replace(" )", ")")
 
 
-def _named(found: Conclusion, missing: MissingForce | None) -> str:
+def _named(found: Conclusion, missing: MissingForce | None, units: Units = SI) -> str:
     """The effects named and tied, with their size where the missing force gave it. The size
     is the improved model's force beyond the baseline's (``latent_views.effect_force``): with
-    several effects added it is theirs together, and said once."""
-    groups = [" / ".join(g) for g in [[_level(e, found.improved_fit)] for e in found.missing]
+    several effects added it is theirs together, and said once (labelled in ``units``)."""
+    groups = [" / ".join(g) for g in [[_level(e, found.improved_fit, units)]
+                                      for e in found.missing]
               + [t.effects for t in found.ties]]
     sizes = missing.sizes if missing is not None else []
     if not sizes:
         return ", ".join(groups)
     s = sizes[0]
     together = "together " if len(sizes) > 1 else ""
-    return (", ".join(groups) + f" ({together}{s.force_rms_N:.3g} N RMS, "
-            f"{s.share_of_drive:.2%} of the drive, {s.label})")
+    return (", ".join(groups) + f" ({together}{s.force_rms_N:.3g} {units.label('force')} "
+            f"RMS, {s.share_of_drive:.2%} of the drive, {s.label})")
 
 
 def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
-             limit: float, missing: MissingForce | None = None) -> str:
+             limit: float, missing: MissingForce | None = None, units: Units = SI) -> str:
     """One line: the verdict, the share of the unseen output the baseline explains, and the
-    noise floor it was judged against."""
+    noise floor it was judged against; sizes labelled in ``units`` (the recording's)."""
     parts = [verdict]
     if fit.explained is not None:
         parts.append(f"{baseline} explains {max(fit.explained, 0.0):.0%} of the {fit.unseen} "
@@ -263,7 +268,7 @@ def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
     if found.missing or found.ties:
         # accepted effects below the relevance floor leave the verdict adequate
         label = "missing" if verdict != "adequate" else "detectable but negligible"
-        parts.append(f"{label}: " + _named(found, missing))
+        parts.append(f"{label}: " + _named(found, missing, units))
     share = fit.library_share()
     if verdict != "adequate":
         parts.append(_library_phrase(share, found.accepted))
