@@ -100,6 +100,21 @@ def test_the_threads_and_blocks_do_not_change_the_result(base_acc):
     np.testing.assert_array_equal(one, simulate(lay, P, base_acc, DT).rel_acc)
 
 
+def test_a_rule_integrates_on_its_own_threads():
+    """runlog.use_threads: a rule's threads become the integrators' (simulate.threads), never
+    more than Numba has."""
+    from harvester.model.simulate import threads
+    from harvester.runlog import use_threads
+    before = numba.get_num_threads()
+    try:
+        assert use_threads(1) == 1 and threads() == 1
+        top = numba.config.NUMBA_NUM_THREADS
+        assert use_threads(top + 5) == top and threads() == top
+        assert use_threads(0) == 1
+    finally:
+        numba.set_num_threads(before)
+
+
 TERM_PARAMS = {
     "tanh_friction": [10.0, 100.0],
     "coulomb_friction": [8.0],

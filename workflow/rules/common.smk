@@ -11,6 +11,12 @@ from harvester.groups import group_settings
 # Conda environment of every rule (used with --use-conda; `make study` uses .venv instead).
 ENV = "../../envs/harvester.yaml"
 
+# Threads of a rule that integrates many models (TMCMC, predictive bounds, diagnosis): one.
+# The study has many such jobs that do not wait on each other, and two one-thread jobs on two
+# cores finished in 0.78x the time of the same two jobs one after the other on two threads each
+# (docs/measurements.md, "The study's time"); with more cores, more jobs run at once.
+JOB_THREADS = 1
+
 # ---------------------------------------------------------------- the paper study's records
 RECORDS = ["training", "validation"]
 # Records with the generator's voltage channel (rig.loaded_records): regenerated, verified and

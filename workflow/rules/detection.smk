@@ -84,7 +84,7 @@ rule diagnose_scenario:
         preprocess=config["preprocess"],
     wildcard_constraints:
         **SCENARIO_WILDCARDS,
-    threads: 2
+    threads: JOB_THREADS
     resources:
         mem_mb=3000,
         runtime=lambda w: 15 if detection_grid()["fast"] else 60,

@@ -16,7 +16,7 @@ rule diagnose:
         group=one_of([g for g in GENERIC_GROUPS if DIAGNOSED[g]]),
     params:
         settings=lambda w: group_params(w.group, "diagnosis"),
-    threads: 2
+    threads: JOB_THREADS
     resources:
         mem_mb=4000,
         runtime=60,

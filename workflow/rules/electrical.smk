@@ -122,7 +122,7 @@ rule power_predict:
         excitation=one_of(EXCITATIONS),
     params:
         power=POWER,
-    threads: 2
+    threads: JOB_THREADS
     log:
         "logs/power/predict_{excitation}.log",
     conda:
@@ -147,7 +147,7 @@ rule power_calibration:
     params:
         power=POWER,
         preprocess=config["preprocess"],
-    threads: 2
+    threads: JOB_THREADS
     log:
         "logs/power/calibration.log",
     conda:

@@ -119,7 +119,7 @@ rule emps_tmcmc:
     params:
         stride=EMPS["stride"],
         tmcmc=EMPS["tmcmc"],
-    threads: 2
+    threads: JOB_THREADS
     resources:
         mem_mb=4000,
         runtime=60,
@@ -189,7 +189,7 @@ rule emps_predictive:
         record="|".join(EMPS_RECORDS),
     params:
         predictive=EMPS["predictive"],
-    threads: 2
+    threads: JOB_THREADS
     log:
         "logs/emps/predictive_{model}_{record}.log",
     conda:

@@ -24,7 +24,7 @@ rule identify:
         group=one_of(GENERIC_GROUPS),
     params:
         settings=lambda w: group_params(w.group, "tmcmc"),
-    threads: 2
+    threads: JOB_THREADS
     resources:
         mem_mb=4000,
         runtime=60,

@@ -26,7 +26,7 @@ rule validate_recording:
     params:
         predictive=lambda w: GROUPS[w.group]["predictive"],
         lead_in_s=lambda w: GROUPS[w.group]["validation_lead_in_s"],
-    threads: 2
+    threads: JOB_THREADS
     resources:
         mem_mb=4000,
         runtime=30,
@@ -70,7 +70,7 @@ rule predictive:
         predictive=config["predictive"],
     wildcard_constraints:
         record="|".join(RECORDS),
-    threads: 2
+    threads: JOB_THREADS
     log:
         "logs/predictive_{model}_{record}.log",
     conda:

@@ -1,7 +1,5 @@
 """Rule diagnose_scenario: the diagnosis of one scenario's recording (JSON)."""
 
-import numba
-
 from harvester.data.daq import read_recording
 from harvester.grid.scoring import run_diagnosis
 from harvester.data.fileio import read_json, write_json
@@ -9,7 +7,6 @@ from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821
     sm = snakemake  # noqa: F821
-    numba.set_num_threads(max(1, min(sm.threads, numba.config.NUMBA_NUM_THREADS)))
     truth = read_json(sm.input.truth)
     recording = read_recording(sm.input.recording)
     fs = 1.0 / float(recording["time"].iloc[1] - recording["time"].iloc[0])

@@ -1,7 +1,6 @@
 """Rule power_calibration: predicted power on the held-out loaded records against the
 measured, coverage beside the nominal rate (harvester.power.calibration)."""
 
-import numba
 from harvester.data.fileio import atomic_path
 from harvester.power import figures
 from harvester.power.run import held_out_study, load_posteriors
@@ -9,7 +8,6 @@ from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821
     sm = snakemake  # noqa: F821
-    numba.set_num_threads(max(1, min(sm.threads, numba.config.NUMBA_NUM_THREADS)))
     posteriors, weights, device = load_posteriors(sm.input.samples, sm.input.weights)
     windows, coverage = held_out_study(posteriors, weights, device, sm.input.records,
                                        sm.input.metas, sm.params.power, sm.params.preprocess)

@@ -4,14 +4,12 @@ and the gain of halving the friction, on one excitation (harvester.power)."""
 from dataclasses import replace
 from pathlib import Path
 
-import numba
 from harvester.power.excitations import describe, read_excitation
 from harvester.power.run import load_posteriors, power_study, write_power_study
 from harvester.runlog import rule_log
 
 with rule_log(snakemake) as log:  # noqa: F821
     sm = snakemake  # noqa: F821
-    numba.set_num_threads(max(1, min(sm.threads, numba.config.NUMBA_NUM_THREADS)))
     name, cfg = sm.wildcards.excitation, sm.params.power
     exc = replace(read_excitation(sm.input.excitation, name),
                   description=describe(name, cfg["excitations"][name]))

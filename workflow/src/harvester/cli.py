@@ -50,7 +50,7 @@ sidecar RECORDING.yaml beside it (optional): M (kg), m (kg), k (N/m), priors
   M 12.8 kg, m 8 kg, k 250 N/m); what was assumed is logged and written to the output.
 exit status: 0 done, 2 bad input (named: file, line or column, found, expected)."""
 
-#: Sampler defaults of the command line (the study's config: 1000 particles x 4 chains).
+#: Sampler defaults of the command line (the study's config: 1000 particles x 2 chains).
 CLI_TMCMC = {"particles": 500, "chains": 2, "mcmc_steps": 3, "target_accept": 0.25}
 DIAGNOSE_NEEDS = ("harvester diagnose (with a base input eq. (1) fixes only ratios to a "
                   "mass: at least one of M, m, k must be known; the others are identified)")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import logging
 import math
+import os
 import re
 import sys
 import time
@@ -80,13 +81,28 @@ class TimeLeft(logging.Filter):
             f"{where} done"
 
 
+def use_threads(n: int) -> int:
+    """Integrate on at most ``n`` threads (a rule's ``threads``, which Snakemake scales to its
+    cores): Numba's thread count when Numba is loaded, else ``NUMBA_NUM_THREADS`` for when it
+    is. The number set."""
+    n = max(1, int(n))
+    if "numba" in sys.modules:
+        numba = sys.modules["numba"]
+        n = min(n, numba.config.NUMBA_NUM_THREADS)
+        numba.set_num_threads(n)
+    else:
+        os.environ["NUMBA_NUM_THREADS"] = str(n)
+    return n
+
+
 @contextlib.contextmanager
 def rule_log(snakemake) -> Iterator[logging.Logger]:  # noqa: ANN001 - the Snakemake object
-    """Log a Snakemake script's run (start, wall time, any error with traceback) to its log."""
+    """Log a Snakemake script's run (start, wall time, any error with traceback) to its log;
+    the integrators run on the rule's threads (:func:`use_threads`)."""
     log_file = snakemake.log[0] if len(snakemake.log) else None
     logger = setup(log_file)
     start = time.perf_counter()
-    logger.info("rule %s started", snakemake.rule)
+    logger.info("rule %s started on %d thread(s)", snakemake.rule, use_threads(snakemake.threads))
     try:
         yield logger
     except Exception:

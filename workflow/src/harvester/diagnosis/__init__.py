@@ -15,8 +15,15 @@ tied); ``separate`` (experiments that would break a tie); ``report`` (unseen-dat
 diagnosis.json); ``figures``; ``run`` (the orchestrator).
 """
 
-from harvester.diagnosis.run import (Diagnosis, DiagnosisSettings, check_recording, diagnose,
-                                     diagnose_study, quick_detect, write)
-
 __all__ = ["Diagnosis", "DiagnosisSettings", "check_recording", "diagnose", "diagnose_study",
            "quick_detect", "write"]
+
+
+def __getattr__(name: str):  # noqa: ANN202 - PEP 562: the entry points load on first use
+    """The entry points above, imported from ``run`` when first asked for, so that a module of
+    the package (``harvester.diagnosis.shapes``, say) loads without the orchestrator's
+    imports (ArviZ, PyMC: seconds for every rule that needs one helper)."""
+    if name in __all__:
+        from harvester.diagnosis import run
+        return getattr(run, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
