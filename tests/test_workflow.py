@@ -79,7 +79,7 @@ def test_the_public_sheet_gives_the_real_recordings_groups(tmp_path):
     sheet = load_sheets(["config/public/recordings.tsv"], SCHEMA, bases=(ROOT,))
     assert set(sheet.groups) == {"frame_250g", "frame_450g", "silverbox"}
     assert all(sheet.row(r)["kind"] == "public" for r in sheet.recordings())
-    assert group_settings(CONFIG, "frame_450g")["diagnose"] == ["linear"]
+    assert group_settings(CONFIG, "frame_450g")["models"] == group_settings(CONFIG, "frame_450g")["diagnose"] == ["linear"]
     frame = public_recording(ROOT / "data/public/marino-frame/s_b_250g_x.mat")
     assert frame.sidecar["friction_on"] == "ground"
     csv = frame.write(tmp_path / "frame.csv")
@@ -142,9 +142,10 @@ def test_dry_runs_of_the_shipped_sheets(tmp_path):
     proc = snakemake(tmp_path, "-n", "all")
     assert proc.returncode == 0, (proc.stdout + proc.stderr)[-4000:]
     both = job_counts(proc.stdout)
-    # the paper's two models and the real recordings' groups (two models each, their linear
-    # model diagnosed; no validation recordings: the diagnosis holds out each record's end)
-    assert both["identify"] == 2 + 3 * 2 and both["diagnose"] == 2 + 3
+    # the paper's two models and the real recordings' groups (the frame's linear model, the
+    # Silverbox's two; the linear ones diagnosed; no validation recordings: the diagnosis holds
+    # out each record's end)
+    assert both["identify"] == 2 + 2 * 1 + 2 and both["diagnose"] == 2 + 3
     assert both["validate_recording"] == 2 and both["convert_public"] == 3
     assert both["emps_tmcmc"] == 4 and both["fig10_tanh_unseen_full"] == 1
     emps = snakemake(tmp_path, "-n", "all", "--configfile", str(ROOT / "config/emps.yaml"))

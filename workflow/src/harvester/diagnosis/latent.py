@@ -300,12 +300,12 @@ def _forces(state: BaselineState, dev: _Device, mean: np.ndarray, paths: np.ndar
 def latent_force(state: BaselineState, window: tuple[int, int] | None = None, *,
                  kernel: str = "matern52", noise: str | float = "fit",
                  draws: int = PATH_DRAWS, seed: int = 0,
-                 initial_sd: float = INITIAL_SD) -> LatentForce:
+                 initial_sd: float = INITIAL_SD, units: Units = SI) -> LatentForce:
     """The missing force of the baseline ``state`` over ``window`` (samples; the problem's
     by default), module docstring. ``kernel``: 'matern32' or 'matern52'; ``noise``: 'fit'
     (marginal likelihood, at most the baseline's sigma), 'baseline' (its sigma) or a value in
     the output's unit (an independent noise floor); ``draws``: joint draws of the state path
-    behind the sd; ``initial_sd``: :data:`INITIAL_SD`."""
+    behind the sd; ``initial_sd``: :data:`INITIAL_SD`; ``units``: the recording's (labels)."""
     if kernel not in MATERN_STATES:
         raise ValueError(f"kernel must be one of {sorted(MATERN_STATES)}, got {kernel!r}")
     clock = time.perf_counter()
@@ -332,8 +332,9 @@ def latent_force(state: BaselineState, window: tuple[int, int] | None = None, *,
         length_scale_s=length, amplitude_N=amp, noise_sd=noise_sd, baseline_noise_sd=sigma_b,
         log_marginal=logml, band_hz=float(getattr(p, "band_hz", np.nan)), stride=dev.stride,
         seconds=time.perf_counter() - clock, filter_order=int(getattr(p, "filter_order", 8)),
-        draws=f_paths[:, w], state_draws=np.stack([z, v, acc_draws]))
-    log.info("latent force of %s: RMS %.3g N (sd %.2g N), length scale %.3g s, noise %.3g "
-             "(baseline's sigma %.3g), %.1f s", p.structure.name, out.rms_N, np.mean(out.sd),
-             length, noise_sd, sigma_b, out.seconds)
+        draws=f_paths[:, w], state_draws=np.stack([z, v, acc_draws]), units=units)
+    unit = units.label("force")
+    log.info("latent force of %s: RMS %.3g %s (sd %.2g %s), length scale %.3g s, noise %.3g "
+             "(baseline's sigma %.3g), %.1f s", p.structure.name, out.rms_N, unit,
+             np.mean(out.sd), unit, length, noise_sd, sigma_b, out.seconds)
     return out

@@ -6,7 +6,7 @@ effect's force beside it with its size and relevance (``relevance``), and the fi
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -61,7 +61,7 @@ def missing_force(state: BaselineState, window: tuple[int, int] | None = None,
     ``unseen_input`` (the held-out or validation input, ``unseen_window`` of it) gives each
     named effect's change of the predicted response; ``units``: the recording's (the labels
     of every size, ``data.units``); figures in ``out_dir`` if given."""
-    lf = replace(latent_force(state, window, **latent_kwargs), units=units)
+    lf = latent_force(state, window, units=units, **latent_kwargs)
     desc = describe(lf)
     out = MissingForce(lf, desc, views(lf))
     for effect in named:
