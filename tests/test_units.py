@@ -155,3 +155,18 @@ def test_the_silverbox_sidecar_says_volts(tmp_path) -> None:
     study = public_recording(SILVERBOX).write(tmp_path / "study.csv")
     prepare_recording(study, study.with_suffix(".yaml"), tmp_path / "g" / "sb.csv")
     assert read_sidecar(tmp_path / "g" / "sb.csv").units == VOLTS
+
+
+def test_the_missing_force_views_are_labelled_in_the_recordings_units() -> None:
+    """latent_views.views: z in mm and F in N for SI; in V (no factor of 1e3) for volts."""
+    from harvester.diagnosis.latent_views import views
+    x = np.linspace(-1.0, 1.0, 100)
+    lf = SimpleNamespace(rel_disp=x, rel_vel=x, time=np.arange(100.0), input=x, force=x**3,
+                         draws=np.tile(x**3, (3, 1)), input_kind="force", units=SI)
+    si = views(lf)
+    assert (si["z"].unit, si["z'"].unit, si["input"].unit) == ("mm", "m/s", "N")
+    assert np.isclose(si["z"].centre.max(), 1e3 * x[-4:].mean(), rtol=0.05)
+    lf.units = Units("V", "V")
+    volts = views(lf)
+    assert (volts["z"].unit, volts["z'"].unit, volts["input"].unit) == ("V", "V/s", "V")
+    assert volts["z"].centre.max() < 1.0 + 1e-12

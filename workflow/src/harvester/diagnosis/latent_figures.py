@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from harvester.data.units import Units
 from harvester.diagnosis.latent import LatentForce
 from harvester.diagnosis.latent_views import Binned, EffectForce, views
 from harvester.diagnosis.shapes import ShapeDescription
@@ -14,19 +15,22 @@ from harvester.plots.style import (BOUNDS, LEGEND_SIZE, MEASURED, MODEL, TITLE_S
                                    axis_label, plt, save_figure)
 
 BAND_COLOUR, BAND_ALPHA = BOUNDS["predictive"]
-FORCE_LABEL = axis_label("missing force f", "N")
+
+
+def _force_label(units: Units, what: str = "missing force f") -> str:
+    return axis_label(what, units.label("force"))
 
 
 def _band(ax, x, lower, upper, label="+-2 sd") -> None:
     ax.fill_between(x, lower, upper, color=BAND_COLOUR, alpha=BAND_ALPHA, lw=0, label=label)
 
 
-def _binned_panel(ax, b: Binned) -> None:
+def _binned_panel(ax, b: Binned, units: Units) -> None:
     _band(ax, b.centre, b.lower, b.upper)
     ax.plot(b.centre, b.mean, "o-", color=MEASURED, ms=3, lw=1, label="latent force (binned)")
     ax.axhline(0.0, color=MODEL, lw=0.5)
     ax.set_xlabel(axis_label(b.label, b.unit))
-    ax.set_ylabel(FORCE_LABEL)
+    ax.set_ylabel(_force_label(units))
 
 
 def _time_panel(ax, lf: LatentForce, desc: ShapeDescription | None) -> None:
@@ -35,7 +39,7 @@ def _time_panel(ax, lf: LatentForce, desc: ShapeDescription | None) -> None:
     if desc is not None:
         ax.plot(lf.time, desc.best.fitted, color=MODEL, lw=0.6, label=f"{desc.best.name} fit")
     ax.set_xlabel(axis_label("time", "s"))
-    ax.set_ylabel(FORCE_LABEL)
+    ax.set_ylabel(_force_label(lf.units))
     ax.legend(fontsize=LEGEND_SIZE, loc="upper right")
 
 
@@ -46,14 +50,15 @@ def latent_force_figure(lf: LatentForce, desc: ShapeDescription | None,
     fig, axes = plt.subplots(3, 2, figsize=(10, 10))
     _time_panel(axes[0, 0], lf, desc)
     ax = axes[0, 1]
-    ax.plot(1e3 * lf.rel_disp, lf.force, color=MEASURED, lw=0.4, label="latent force")
+    scale, z_unit = lf.units.small("displacement")
+    ax.plot(scale * lf.rel_disp, lf.force, color=MEASURED, lw=0.4, label="latent force")
     if desc is not None:
-        ax.plot(1e3 * lf.rel_disp, desc.best.fitted, color=MODEL, lw=0.4, label="shape fit")
-    ax.set_xlabel(axis_label("z", "mm"))
-    ax.set_ylabel(FORCE_LABEL)
+        ax.plot(scale * lf.rel_disp, desc.best.fitted, color=MODEL, lw=0.4, label="shape fit")
+    ax.set_xlabel(axis_label("z", z_unit))
+    ax.set_ylabel(_force_label(lf.units))
     ax.set_title("loop in (z, f)", fontsize=TITLE_SIZE)
     for ax, b in zip(axes[1:].ravel(), views(lf).values()):
-        _binned_panel(ax, b)
+        _binned_panel(ax, b, lf.units)
     axes[1, 0].legend(fontsize=LEGEND_SIZE)
     title = desc.sentence if desc is not None else f"missing force of {lf.baseline}"
     fig.suptitle(_wrap(f"{lf.baseline}: {title}"), fontsize=TITLE_SIZE)
@@ -73,14 +78,15 @@ def effect_force_figure(ef: EffectForce, path: str | Path, excerpt_s: float = 5.
     ax.plot(ef.time[sel], ef.change[sel], color=MODEL, lw=0.8,
             label=f"improved - baseline ({ef.term})")
     ax.set_xlabel(axis_label("time", "s"))
-    ax.set_ylabel(axis_label("force", "N"))
+    ax.set_ylabel(_force_label(ef.units, "force"))
     ax.legend(fontsize=LEGEND_SIZE)
-    for ax, x, label in ((axes[1], ef.rel_vel, axis_label("z'", "m/s")),
-                         (axes[2], 1e3 * ef.rel_disp, axis_label("z", "mm"))):
+    scale, z_unit = ef.units.small("displacement")
+    for ax, x, label in ((axes[1], ef.rel_vel, axis_label("z'", ef.units.label("velocity"))),
+                         (axes[2], scale * ef.rel_disp, axis_label("z", z_unit))):
         ax.plot(x, ef.latent, ".", color=MEASURED, ms=1, label="latent force")
         ax.plot(x, ef.change, ".", color=MODEL, ms=1, label="improved - baseline")
         ax.set_xlabel(label)
-        ax.set_ylabel(axis_label("force", "N"))
+        ax.set_ylabel(_force_label(ef.units, "force"))
     fig.suptitle(f"{ef.term}: explains {100 * max(ef.share, 0):.0f} % of the latent force, "
                  f"{100 * ef.coverage:.0f} % of samples within its band", fontsize=TITLE_SIZE)
     return save_figure(fig, path, rect=(0, 0, 1, 0.93))

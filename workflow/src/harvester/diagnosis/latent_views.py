@@ -22,20 +22,24 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from harvester.data.units import SI, Units
 from harvester.diagnosis.latent import LatentForce
 from harvester.diagnosis.term_forces import model_force, term_force
 from harvester.model.structures import Layout, ModelStructure, structure
 from harvester.model.terms import term
 
-#: What the force is viewed against: (LatentForce attribute, label, unit, scale to the unit).
-AGAINST = {"z": ("rel_disp", "z", "mm", 1e3), "z'": ("rel_vel", "z'", "m/s", 1.0),
-           "time": ("time", "time", "s", 1.0), "input": ("input", "input", None, 1.0)}
-INPUT_UNITS = {"base_acc": ("y''", "m/s^2"), "force": ("F", "N")}
+#: What the force is viewed against: (LatentForce attribute, label, quantity of
+#: ``data.units``, shown small: in mm where the displacement is in m).
+AGAINST = {"z": ("rel_disp", "z", "displacement", True), "z'": ("rel_vel", "z'", "velocity", False),
+           "time": ("time", "time", "s", False), "input": ("input", "input", None, False)}
+#: The input's label and quantity, by its kind.
+INPUT_UNITS = {"base_acc": ("y''", "acceleration"), "force": ("F", "force")}
 
 
 @dataclass
 class Binned:
-    """Binned means of the missing force (N) against one quantity, with +-2 sd bands."""
+    """Binned means of the missing force (the recording's force unit) against one quantity,
+    with +-2 sd bands."""
 
     against: str
     label: str
@@ -53,9 +57,10 @@ class Binned:
 
 def binned(lf: LatentForce, against: str, bins: int = 24) -> Binned:
     """f's binned means against ``against`` (a key of AGAINST), bins of equal count."""
-    attr, label, unit, scale = AGAINST[against]
+    attr, label, quantity, small = AGAINST[against]
     if against == "input":
-        label, unit = INPUT_UNITS.get(lf.input_kind, ("input", ""))
+        label, quantity = INPUT_UNITS.get(lf.input_kind, ("input", ""))
+    scale, unit = lf.units.small(quantity) if small else (1.0, lf.units.label(quantity))
     x = np.asarray(getattr(lf, attr), dtype=float) * scale
     edges = np.unique(np.quantile(x, np.linspace(0.0, 1.0, bins + 1)))
     idx = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, len(edges) - 2)
@@ -77,7 +82,8 @@ def views(lf: LatentForce, bins: int = 24) -> dict[str, Binned]:
 
 @dataclass
 class EffectForce:
-    """A named effect's force beside the latent force (module docstring), in N."""
+    """A named effect's force beside the latent force (module docstring), in the recording's
+    force unit (``units``)."""
 
     term: str
     time: np.ndarray
@@ -90,6 +96,7 @@ class EffectForce:
     rms_N: float  # RMS of dF
     rel_disp: np.ndarray = field(repr=False, default_factory=lambda: np.empty(0))
     rel_vel: np.ndarray = field(repr=False, default_factory=lambda: np.empty(0))
+    units: Units = SI
 
     def to_dict(self) -> dict:
         return {"term": self.term, "share_of_latent_explained": self.share,
@@ -125,7 +132,7 @@ def effect_force(lf: LatentForce, improved: ModelStructure, theta: np.ndarray,
     share = 1.0 - float(np.sum((f - change) ** 2) / max(np.sum(f**2), 1e-300))
     coverage = float(np.mean(np.abs(f - change) < 2.0 * lf.sd))
     return EffectForce(term_name, lf.time, f, lf.sd, change, own, share, coverage,
-                       float(np.sqrt(np.mean(change**2))), lf.rel_disp, lf.rel_vel)
+                       float(np.sqrt(np.mean(change**2))), lf.rel_disp, lf.rel_vel, lf.units)
 
 
 def _layout_of(lf: LatentForce) -> Layout:

@@ -26,11 +26,17 @@ from harvester.model.codegen import compiled
 from harvester.model.structures import Layout
 from harvester.model.terms import Term
 
+#: Why the loops below are not cached on disk: they take a term's compiled laws as arguments,
+#: and a compiled law's type differs in every process, so Numba's cache never found an entry,
+#: added one per process (121 in a working copy) and at times failed to write its index
+#: ("underlying object has vanished"). They compile once per process instead.
+NOT_CACHED = ("_stateless", "_with_update", "_with_rates", "_mode")
+
 #: Fewest sub-steps per sample for a mode's states, and its largest omega_n h.
 MODE_SUBSTEPS, MODE_RATE_H = 4, 0.3
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=False)  # takes compiled laws: see NOT_CACHED
 def _stateless(force, x, params):
     out = np.empty_like(x)
     for i in range(x.shape[0]):
@@ -39,7 +45,7 @@ def _stateless(force, x, params):
     return out
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=False)  # takes compiled laws: see NOT_CACHED
 def _with_update(force, update, v, dt, params):
     """A screw term with one rate-independent state: h advanced by the exact update along
     each step's displacement (trapezoidal velocity), from h = 0."""
@@ -53,7 +59,7 @@ def _with_update(force, update, v, dt, params):
     return out
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=False)  # takes compiled laws: see NOT_CACHED
 def _with_rates(force, rates, v, dt, n_sub, params):
     """A screw term with one state: h' = rates(w, h) by RK2 with ``n_sub`` steps per
     sample, w linear in the sample, from h = 0."""
@@ -73,7 +79,7 @@ def _with_rates(force, rates, v, dt, n_sub, params):
     return out
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=False)  # takes compiled laws: see NOT_CACHED
 def _mode(force, rates, a, yb, dt, n_sub, params):
     """A mode's force on the mass along paths of z'' (a) and y'' (yb), RK4 from rest."""
     out = np.empty_like(a)

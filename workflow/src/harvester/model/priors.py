@@ -86,7 +86,12 @@ class PriorSpec:
         return np.log(np.maximum(x, 1e-300)) if self.is_log else x
 
     def from_coordinate(self, u: Any) -> Any:
-        return np.exp(u) if self.is_log else u
+        """The inverse of :meth:`to_coordinate`; a coordinate beyond a float's range (a wild
+        proposal's) gives inf, which the prior's bounds reject, without a warning."""
+        if not self.is_log:
+            return u
+        with np.errstate(over="ignore"):
+            return np.exp(u)
 
     @property
     def center(self) -> float:
