@@ -95,3 +95,25 @@ def test_a_named_effect_is_said_with_its_kind_and_its_fitted_strength_in_its_uni
     assert _level("cubic_stiffness", Fit()).startswith("cubic_stiffness (k_cubic 2e+06 +- 1e+05 ")
     assert _level("coulomb_friction", None) == "coulomb_friction (friction)"
     assert _level("inertia_error", None) == "inertia_error"
+
+
+def test_a_named_effect_s_strength_comes_from_the_round_that_named_it():
+    """A later round's tie fits a model that need not describe the named effect (on the frame
+    at 450 g a tied cubic stiffness took F_hyst from 1.12 to 0.028 N): the strength shown is
+    the named round's (Conclusion.named_fit), the improved fit only when none is kept."""
+    from harvester.diagnosis.verdict import Conclusion, Tie, _named
+
+    class Fit:
+        def __init__(self, f):
+            self.f = f
+
+        def summary(self):
+            return {"F_hyst": {"mean": self.f, "sd": 0.01}}
+    tie = Tie(["cubic_stiffness", "unmodelled_mode"], {})
+    found = Conclusion("missing_physics", ["hysteresis"], [tie], False, [], Fit(0.028),
+                       True, named_fit=Fit(1.12))
+    said = _named(found, None)
+    assert said.startswith("hysteresis (friction, F_hyst 1.12 +- 0.01 N)"), said
+    assert "cubic_stiffness / unmodelled_mode" in said
+    alone = Conclusion("missing_physics", ["hysteresis"], [], False, [], Fit(0.7), True)
+    assert "F_hyst 0.7 +- 0.01 N" in _named(alone, None)

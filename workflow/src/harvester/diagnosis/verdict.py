@@ -138,7 +138,9 @@ class Tie:
 class Conclusion:
     """The verdict, the effects named (each alone), the ties, whether a detected mismatch is
     left unexplained, notes, the improved model's fit (the last accepted), whether an effect
-    was accepted, the fit judgement and the verdict's one-line headline (``judge``)."""
+    was accepted, the fit judgement, the verdict's one-line headline (``judge``) and the fit
+    of the last round that named its effect (where a named effect's strength is read: a later
+    tie's model need not describe it)."""
 
     verdict: str
     missing: list[str]
@@ -149,6 +151,7 @@ class Conclusion:
     accepted: bool = False
     fit: FitJudgement | None = None
     headline: str = ""
+    named_fit: ModelFit | None = None
 
 
 def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings,
@@ -171,8 +174,10 @@ def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings
                 notes.append(f"{r.effect}: the posterior of {', '.join(r.at_prior_edge)} piles "
                              "against its prior's bound; the candidate is not trusted")
     verdict = decide_verdict(first.p_value, bool(accepted), settings.unexplained_alpha)
+    named = [a.fit for a in accepted if a.named]
     return Conclusion(verdict, missing, ties, bool(unexplained), notes,
-                      accepted[-1].fit if accepted else None, bool(accepted))
+                      accepted[-1].fit if accepted else None, bool(accepted),
+                      named_fit=named[-1] if named else None)
 
 
 def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
@@ -236,9 +241,10 @@ def _level(effect: str, fit: ModelFit | None, units: Units = SI) -> str:
 def _named(found: Conclusion, missing: MissingForce | None, units: Units = SI) -> str:
     """The effects named and tied, with their size where the missing force gave it. The size
     is the improved model's force beyond the baseline's (``latent_views.effect_force``): with
-    several effects added it is theirs together, and said once (labelled in ``units``)."""
-    groups = [" / ".join(g) for g in [[_level(e, found.improved_fit, units)]
-                                      for e in found.missing]
+    several effects added it is theirs together, and said once (labelled in ``units``). A
+    named effect's strength is read from the last round that named one (``named_fit``)."""
+    fit = found.named_fit or found.improved_fit
+    groups = [" / ".join(g) for g in [[_level(e, fit, units)] for e in found.missing]
               + [t.effects for t in found.ties]]
     sizes = missing.sizes if missing is not None else []
     if not sizes:
