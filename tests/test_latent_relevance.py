@@ -68,3 +68,28 @@ def test_the_diagnosis_baseline_state_goes_through_in_one_call():
     assert best.name == "friction" and 5.0 < best.parameters["F_N"] < 14.0
     assert best.parameters["c_N_s_per_m"] < 0.0
     assert json.loads(json.dumps(out.to_dict()))["latent_force"]["output_kind"] == "rel_acc"
+
+
+def test_a_residual_the_smoother_cannot_carry_is_not_called_no_missing_force():
+    """verdict.latent_unread: the smoother's noise at its bound (the baseline's sigma) and no
+    force beyond its band, while the residual is far above the recording's own noise floor,
+    is said as unread (the frame at 450 g), not as "no missing force"; below the floor's limit,
+    or with the noise fitted below its bound, the description stands."""
+    from types import SimpleNamespace
+
+    from harvester.diagnosis.verdict import Conclusion, FitJudgement, headline, latent_unread
+    lf = SimpleNamespace(noise_sd=2.8e-4, baseline_noise_sd=2.8e-4, force=np.full(50, 0.1),
+                         sd=np.full(50, 0.2))
+    missing = SimpleNamespace(latent=lf, sizes=[], description=SimpleNamespace(
+        sentence="no missing force beyond its uncertainty (RMS 0.1 N against an sd of 0.2 N)"))
+    floor = SimpleNamespace(rms=1.0, bound="upper", method="repeated_periods")
+    far = FitJudgement(0.95, 0.227, "holdout", 15.0, floor)
+    assert latent_unread(missing, far, 3.0)
+    found = Conclusion("missing_physics", [], [], True, [], None, False)
+    said = headline("missing_physics", found, far, "linear", 3.0, missing)
+    assert "not readable by the smoother" in said and "no missing force" not in said
+    assert not latent_unread(missing, FitJudgement(0.95, 0.227, "holdout", 2.0, floor), 3.0)
+    assert not latent_unread(missing, FitJudgement(0.95, 0.227, "holdout", 15.0, None), 3.0)
+    lf.noise_sd = 1.8e-4
+    assert not latent_unread(missing, far, 3.0)
+    assert "no missing force" in headline("missing_physics", found, far, "linear", 3.0, missing)

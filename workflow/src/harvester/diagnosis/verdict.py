@@ -35,6 +35,25 @@ log = logging.getLogger("harvester.diagnosis")
 
 #: Rivals of a tie whose separating experiments are computed (the closest first).
 TIE_RIVALS = 2
+#: The smoother's noise at this share of the baseline's sigma or more: its bound, the whole
+#: residual taken as noise.
+NOISE_AT_BOUND = 0.99
+
+
+def latent_unread(missing: MissingForce | None, fit: FitJudgement, limit: float) -> bool:
+    """Whether the missing force could not be read rather than found absent: the smoother put
+    the whole residual in its noise (its noise sd at its bound, the baseline's sigma) and
+    found no force beyond its band, while the residual lies above ``limit`` x the recording's
+    own noise floor. Its model, the baseline's dynamics driven by a smooth force, does not
+    fit such a residual (the frame at 450 g: its log marginal likelihood fell from 553 at
+    the baseline's sigma to below -1200 at the floor's 2e-5 m, at every length scale and
+    amplitude tried), so "no missing force" would be said of a mismatch 15 x the floor."""
+    if missing is None or not fit.above(limit):
+        return False
+    from harvester.diagnosis.shapes import beyond_uncertainty
+    lf = missing.latent
+    return (lf.noise_sd >= NOISE_AT_BOUND * lf.baseline_noise_sd
+            and not beyond_uncertainty(lf))
 
 
 def decide_verdict(p_value: float, accepted: bool, unexplained_alpha: float, *,
@@ -213,6 +232,12 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
         notes.append(f"{baseline} explains only {fit.explained:.0%} of the unseen output, but its "
                      "residual lies at the recording's noise floor: the noise limits what any "
                      "model can explain")
+    if latent_unread(missing, fit, limit):
+        notes.append(f"the missing force could not be read: the smoother took the whole "
+                     f"residual as noise ({missing.latent.noise_sd:.3g}, the baseline's sigma) "
+                     f"while it is {fit.ratio:.3g} x the recording's noise floor; its model, the "
+                     "baseline driven by a smooth force, does not fit this residual (not: "
+                     "nothing is missing)")
     if fit.floor is None:
         notes.append("no noise floor of the recording's own could be measured (no repeated "
                      "periods, quiet lead-in or white band): the verdict rests on the "
@@ -278,7 +303,10 @@ def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
     share = fit.library_share()
     if verdict != "adequate":
         parts.append(_library_phrase(share, found.accepted))
-        if not found.accepted and missing is not None:
+        if not found.accepted and latent_unread(missing, fit, limit):
+            parts.append("the missing force: not readable by the smoother (its noise took the "
+                         "whole residual)")
+        elif not found.accepted and missing is not None:
             parts.append(f"the missing force: {missing.description.sentence}")
     return "; ".join(parts)
 
