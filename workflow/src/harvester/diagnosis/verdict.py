@@ -29,6 +29,7 @@ from harvester.diagnosis.floor import Floor
 from harvester.diagnosis.missing_force import MissingForce
 from harvester.diagnosis.rounds import Round
 from harvester.diagnosis.separate import Separation, separations
+from harvester.diagnosis.shapes import beyond_uncertainty
 from harvester.diagnosis.settings import DiagnosisSettings
 
 log = logging.getLogger("harvester.diagnosis")
@@ -50,7 +51,6 @@ def latent_unread(missing: MissingForce | None, fit: FitJudgement, limit: float)
     amplitude tried), so "no missing force" would be said of a mismatch 15 x the floor."""
     if missing is None or not fit.above(limit):
         return False
-    from harvester.diagnosis.shapes import beyond_uncertainty
     lf = missing.latent
     return (lf.noise_sd >= NOISE_AT_BOUND * lf.baseline_noise_sd
             and not beyond_uncertainty(lf))
