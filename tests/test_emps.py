@@ -105,6 +105,25 @@ def test_pulses_enter_the_validation_loop(validation) -> None:
     assert err[0] < 4e-6 < 10 * err[0] < err[1]
 
 
+def test_map_fit_finds_the_published_friction(training) -> None:
+    """The MAP that starts the study's TMCMC (``fit_map`` on the closed loop): its residuals
+    are the likelihood's (same sums of squares), and on 8 s it lands within 10 % of the
+    published Fc and Fv (20.4 N, 203.5 N s/m), from broad priors centred away from them."""
+    from harvester.diagnosis.baseline import fit_map
+    rec = sliced(training, 8.0)
+    p = emps.closed_loop_problem(rec, MODEL)
+    th = published_theta(p)
+    sse, ok = p.residual_sums(th)
+    assert ok[0] and np.isclose(np.sum(p.residuals(th) ** 2), sse[0], rtol=1e-9)
+    broad = {"M": (90.0, 30.0, "kg", 0.0), "c_m": (150.0, 100.0, "N s/m", 0.0),
+             "F_offset": (0.0, 10.0, "N", -np.inf), "F_coulomb": (10.0, 20.0, "N", 0.0),
+             "sigma": (1e-5, 1e-5, "m", 0.0)}
+    priors = {n: PriorSpec(n, *v) for n, v in broad.items()}
+    fit = dict(zip(p.parameter_names, fit_map(p, priors, seed=0).theta))
+    assert abs(fit["F_coulomb"] / emps.PUBLISHED["Fc"] - 1.0) < 0.1
+    assert abs(fit["c_m"] / emps.PUBLISHED["Fv"] - 1.0) < 0.1
+
+
 def test_likelihood_prefers_coulomb_friction(training) -> None:
     rec = sliced(training, 8.0)
     p = emps.closed_loop_problem(rec, MODEL)

@@ -119,6 +119,7 @@ rule emps_tmcmc:
     params:
         stride=EMPS["stride"],
         tmcmc=EMPS["tmcmc"],
+        start=EMPS["start"],
     threads: JOB_THREADS
     resources:
         mem_mb=4000,
