@@ -508,3 +508,38 @@ def test_a_failed_fit_is_sampled_only_where_a_trusted_importance_estimate_leaves
     assert "at most" in skip_reason(stop, [], cs, 3)  # trusted, and it rules the fit out
     stop.importance_gain = 12.0  # trusted, and the optimiser had missed: sampled
     assert skip_reason(stop, [], cs, 3) is None
+
+
+class _TwoBasins:
+    """A stand-in problem whose sum of squares has two basins in its one parameter a:
+    r = (a^2 - 1, 0.3 (a - 1)), the best at a = 1 (SSE 0) and a local one near a = -1 (SSE
+    about 0.36)."""
+
+    class structure:  # noqa: N801 (the attribute fit_map reads)
+        free_parameters = ("a",)
+        name = "two_basins"
+
+    parameter_names = ("a", "sigma")
+    temper = 1.0
+    n_data = 2
+    measured_chain = np.zeros(2)
+
+    def residuals(self, theta: np.ndarray) -> np.ndarray:
+        a = np.atleast_2d(theta)[:, 0]
+        return np.column_stack([a * a - 1.0, 0.3 * (a - 1.0)])
+
+    def predicted(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return -self.residuals(theta), np.ones(len(np.atleast_2d(theta)), dtype=bool)
+
+
+def test_map_solves_from_several_starts_keep_the_best_end() -> None:
+    """``fit_map(solves=k)`` runs least squares from the k best starts and keeps the best end:
+    the best start (a = -1.0, SSE 0.36) lies in the worse basin, the second (a = 0.5, SSE
+    0.585) in the better one; one solve stays at a = -1, two reach a = 1."""
+    from harvester.diagnosis.baseline import fit_map
+    priors = {"a": PriorSpec("a", 0.0, 2.0, "-", lower=-np.inf)}
+    starts = np.array([[-1.0], [0.5]])
+    one = fit_map(_TwoBasins(), priors, n_starts=0, start=starts, solves=1).theta[0]
+    two = fit_map(_TwoBasins(), priors, n_starts=0, start=starts, solves=2).theta[0]
+    assert one < -0.9
+    assert abs(two - 1.0) < 1e-3

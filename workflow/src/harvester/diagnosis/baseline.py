@@ -249,15 +249,16 @@ class PriorCoordinates:
 
 
 def fit_map(problem: ChainProblem, priors: Mapping[str, PriorSpec], n_starts: int = 48,
-            seed: int = 0, start: np.ndarray | None = None) -> PointFit:
+            seed: int = 0, start: np.ndarray | None = None, solves: int = 1) -> PointFit:
     """Posterior mode of the free physical parameters, sigma profiled (sigma = RMS residual).
 
     Minimises lambda n/2 log(sum r^2) + 1/2 sum_j w_j u_j^2 over u within the priors' bounds
     (u the prior coordinates, :class:`PriorCoordinates`; w_j = 0 for a flat prior; lambda =
     ``problem.temper``, r through the measurement chain), by trust-region least squares,
-    started from the best of ``n_starts`` prior draws, the prior's centre and ``start`` (free
-    physical parameters, a vector or rows of them, optional) evaluated in one batched
-    simulation. Jacobians by forward differences, one batched simulation each.
+    started from the best ``solves`` of ``n_starts`` prior draws, the prior's centre and
+    ``start`` (free physical parameters, a vector or rows of them, optional) evaluated in one
+    batched simulation, keeping the best end. Jacobians by forward differences, one batched
+    simulation each.
     """
     coords = PriorCoordinates.of(problem, priors)
     w = coords.penalty
@@ -277,16 +278,17 @@ def fit_map(problem: ChainProblem, priors: Mapping[str, PriorSpec], n_starts: in
         return np.where(np.isfinite(val), val, np.inf)
 
     extra = None if start is None else np.array([coords.u(row) for row in np.atleast_2d(start)])
-    u0 = _best_start(coords, n_starts, seed, objective_rows, extra)
-    u = _least_squares(resid_u, u0, coords, temper, n)
+    ends = [_least_squares(resid_u, u0, coords, temper, n)
+            for u0 in _best_starts(coords, n_starts, seed, objective_rows, extra, solves)]
+    u = ends[int(np.argmin(objective_rows(np.array(ends))))] if len(ends) > 1 else ends[0]
     sigma_prior = priors.get("sigma")  # None: no Laplace evidence (sigma has no default)
     return _point_fit(problem, coords, u, resid_u, temper, n, count, sigma_prior)
 
 
-def _best_start(coords: PriorCoordinates, n_starts: int, seed: int, objective,
-                extra: np.ndarray | None = None) -> np.ndarray:
-    """The best of the prior's centre, ``n_starts`` draws from the priors and ``extra`` (rows
-    of u; rows with a non-finite value are left out)."""
+def _best_starts(coords: PriorCoordinates, n_starts: int, seed: int, objective,
+                 extra: np.ndarray | None = None, keep: int = 1) -> np.ndarray:
+    """The best ``keep`` rows (best first) of the prior's centre, ``n_starts`` draws from the
+    priors and ``extra`` (rows of u; rows with a non-finite value are left out)."""
     low, high = coords.bounds()
     rng = np.random.default_rng(seed)
     p = len(low)
@@ -300,7 +302,7 @@ def _best_start(coords: PriorCoordinates, n_starts: int, seed: int, objective,
         extra = np.atleast_2d(extra)
         rows.append(inside(extra[np.all(np.isfinite(extra), axis=1)]))
     candidates = np.vstack(rows)
-    return candidates[int(np.argmin(objective(candidates)))]
+    return candidates[np.argsort(objective(candidates), kind="stable")[:max(keep, 1)]]
 
 
 def _least_squares(resid_u, u0: np.ndarray, coords: PriorCoordinates, temper: float,
