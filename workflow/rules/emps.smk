@@ -119,7 +119,6 @@ rule emps_tmcmc:
     params:
         stride=EMPS["stride"],
         tmcmc=EMPS["tmcmc"],
-        start=EMPS["start"],
     threads: JOB_THREADS
     resources:
         mem_mb=4000,

@@ -4,8 +4,6 @@ import numpy as np
 
 from harvester import emps
 from harvester.data.fileio import atomic_path, read_json
-from harvester.diagnosis.baseline import fit_map
-from harvester.diagnosis.confirm import map_reference
 from harvester.inference.identify import TMCMCSettings, identify
 from harvester.inference.priors import PriorSpec
 from harvester.runlog import rule_log
@@ -18,10 +16,7 @@ with rule_log(snakemake) as log:  # noqa: F821
     problem = emps.closed_loop_problem(rec, emps.model_terms(sm.wildcards.model),
                                        prior_file["known"], stride=sm.params.stride,
                                        temper=prior_file["temper"])
-    settings = TMCMCSettings.from_config(sm.params.tmcmc)
-    start = (map_reference(fit_map(problem, priors, seed=settings.seed), priors)
-             if sm.params.start == "map" else None)
-    idata = identify(problem, priors, settings, reference=start)
+    idata = identify(problem, priors, TMCMCSettings.from_config(sm.params.tmcmc))
     idata.posterior.attrs["stride"] = problem.stride
     idata.posterior.attrs["temper"] = problem.temper
     idata.posterior.attrs["record"] = rec.name

@@ -120,22 +120,6 @@ class ClosedLoopProblem(Problem):
                              window=self.window, stride=self.stride, outputs=False)
         return sse, sim.ok
 
-    # What the MAP fit reads of a problem (``harvester.diagnosis.baseline.fit_map``): the
-    # position over the record, and its residual on the likelihood's samples.
-    @property
-    def measured_chain(self) -> np.ndarray:
-        """The measured position over the record (m), as the residual takes it."""
-        return self.output
-
-    def predicted(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(the simulated position over the record (N, n) NaN where failed, ok (N,))."""
-        sim = self.simulate(np.atleast_2d(theta))
-        return self.output_of(sim), sim.ok
-
-    def residuals(self, theta: np.ndarray) -> np.ndarray:
-        """Measured minus simulated position on the likelihood's samples (N, n_data; m)."""
-        return self.observed[None, :] - self.predicted(theta)[0][:, self.samples]
-
     def simulate(self, theta: np.ndarray, input: np.ndarray | None = None, *,
                  base_acc: np.ndarray | None = None) -> Simulation:
         if input is not None or base_acc is not None:

@@ -10,11 +10,14 @@ import arviz as az
 
 from harvester.inference.likelihood import Problem
 from harvester.inference.posterior import set_known
-from harvester.inference.priors import PriorSpec
+from harvester.inference.priors import PriorSpec, priors_for
 from harvester.inference.pymc_model import build_model
 from harvester.inference.tmcmc import Reference, run_tmcmc
 
 log = logging.getLogger("harvester.inference.identify")
+
+#: Where TMCMC's particles start (``TMCMCSettings.start``).
+STARTS = ("prior", "map")
 
 
 @dataclass(frozen=True)
@@ -30,6 +33,13 @@ class TMCMCSettings:
     max_mcmc_steps: int | None = 30
     correlation_threshold: float = 0.1
     seed: int = 0
+    #: "prior": every particle from the prior (Ching and Chen); "map": half of them at the
+    #: model's MAP with its Laplace covariance widened (:func:`map_start`)
+    start: str = "prior"
+
+    def __post_init__(self) -> None:
+        if self.start not in STARTS:
+            raise ValueError(f"tmcmc start must be one of {STARTS}, got {self.start!r}")
 
     @classmethod
     def from_config(cls, cfg: Mapping) -> "TMCMCSettings":
@@ -49,7 +59,10 @@ def identify(problem: Problem, priors: Mapping[str, PriorSpec],
     """Posterior samples and log evidence of ``problem`` by TMCMC (ArviZ InferenceData).
 
     ``reference``: temper from it instead of the prior (``harvester.inference.tmcmc.Reference``); its
-    prior must be the one ``priors`` gives its variable."""
+    prior must be the one ``priors`` gives its variable. Without one, ``settings.start`` "map"
+    tempers from :func:`map_start`."""
+    if reference is None and settings.start == "map":
+        reference = map_start(problem, priors, settings.seed)
     model = build_model(problem, priors)
     log.info("TMCMC for %s: parameters %s, %d particles x %d chains, %d data points",
              problem.structure.name, ", ".join(problem.parameter_names), settings.particles,
@@ -65,3 +78,18 @@ def identify(problem: Problem, priors: Mapping[str, PriorSpec],
     idata.posterior.attrs["input_kind"] = problem.input_kind
     idata.posterior.attrs["output_kind"] = problem.output_kind
     return idata
+
+
+def map_start(problem: Problem, priors: Mapping[str, PriorSpec], seed: int = 0
+              ) -> Reference | None:
+    """The reference a "map" start tempers from: half the particles at the model's MAP with
+    its Laplace covariance widened, the other half from the prior (the diagnosis's start,
+    ``diagnosis.confirm.map_reference``). The tempering then skips the stages that walk from
+    the prior to the posterior (EMPS: 3 stages instead of 10, 0.2x the time); the evidence is
+    still the model's, tempered from a normalised defensive mixture. None where the Laplace
+    covariance is not usable (then from the prior)."""
+    # the MAP fit and its Laplace covariance live with the diagnosis, their first user
+    from harvester.diagnosis.baseline import fit_map
+    from harvester.diagnosis.confirm import map_reference
+    used = priors_for(problem, priors)
+    return map_reference(fit_map(problem, used, seed=seed), used)

@@ -229,6 +229,23 @@ class Problem:
         """How the simulated output is sampled and filtered before it meets ``observed``."""
         return Acquisition(self.oversample, self.output_filter)
 
+    # What a MAP fit reads of a problem (``harvester.diagnosis.baseline.fit_map``; its
+    # ChainProblem puts both sides through its own low-pass).
+    @property
+    def measured_chain(self) -> np.ndarray:
+        """The measured output over the record as the residual takes it."""
+        return self.acquired_output
+
+    def predicted(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(the simulated output over the record (N, n), NaN where failed; ok (N,))."""
+        sim = self.simulate(np.atleast_2d(theta))
+        return self.output_of(sim), sim.ok
+
+    def residuals(self, theta: np.ndarray) -> np.ndarray:
+        """Measured minus simulated output on the likelihood's samples (N, n_data): the
+        residuals whose sum of squares is :meth:`residual_sums`'s."""
+        return self.observed[None, :] - self.predicted(theta)[0][:, self.samples]
+
     def residual_sums(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(sum of squared residuals over the likelihood's samples, ok) per row of theta,
         computed block by block by the compiled simulator (no trajectories are kept)."""
