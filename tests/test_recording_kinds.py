@@ -142,6 +142,18 @@ def test_make_problem_picks_up_the_kinds(inp, out) -> None:
     assert np.max(np.abs(pred - clean)) < 1e-9 * np.max(np.abs(clean)) + 1e-12
 
 
+@pytest.mark.parametrize("inp, out", COMBINATIONS)
+def test_residuals_are_the_likelihoods(inp, out) -> None:
+    """``Problem.residuals`` (what a MAP fit reads) square-sum to ``residual_sums`` (what
+    eq. (10) reads), through the DAQ's oversampling and the recording's output filter."""
+    df = synthetic(inp, out, n=400)
+    known = {"m": TRUTH["m"]} if inp == "base_acc" else {}
+    p = make_problem(df, "linear+coulomb_friction", known, output_filter=(40.0, 8))
+    theta = np.array([[1.1 * TRUTH[n] for n in p.structure.free_parameters] + [0.01]])
+    sse, ok = p.residual_sums(theta)
+    assert ok[0] and np.isclose(np.sum(p.residuals(theta) ** 2), sse[0], rtol=1e-6)
+
+
 def test_force_input_needs_no_m_and_base_input_needs_a_scale() -> None:
     p = make_problem(synthetic("force", "rel_disp", n=200), "linear", {"k": 0.0})
     assert p.structure.free_base == ("M", "c_m") and p.known["m"] == 0.0
