@@ -7,6 +7,7 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from harvester.data.errors import DataError
@@ -170,3 +171,18 @@ def test_the_missing_force_views_are_labelled_in_the_recordings_units() -> None:
     volts = views(lf)
     assert (volts["z"].unit, volts["z'"].unit, volts["input"].unit) == ("V", "V/s", "V")
     assert volts["z"].centre.max() < 1.0 + 1e-12
+
+
+def test_a_displacement_in_volts_is_not_judged_as_metres(tmp_path) -> None:
+    """A fast 'displacement' (24 V/s RMS, the Silverbox's scale) warns "in mm?" without a
+    unit, and says nothing where the sidecar gives it in volts."""
+    from harvester.data.daq import read_checked_recording
+    t = np.arange(2000) / 610.0
+    x = 0.2 * np.sin(2 * np.pi * 20.0 * t)  # derivative RMS about 18 (units/s)
+    f = 0.1 * np.sin(2 * np.pi * 20.0 * t + 0.3)
+    path = tmp_path / "circuit.csv"
+    pd.DataFrame({"time": t, "force": f, "rel_disp": x}).to_csv(path, index=False)
+    fast = [w for w in read_checked_recording(path).warnings if "in mm?" in str(w)]
+    assert len(fast) == 1
+    (tmp_path / "circuit.yaml").write_text("units: {force: V, displacement: V}\n")
+    assert not [w for w in read_checked_recording(path).warnings if "in mm?" in str(w)]

@@ -29,6 +29,7 @@ from dataclasses import asdict
 from pathlib import Path
 
 from harvester.data.errors import DataError
+from harvester.inference import TMCMC_STARTS
 
 log = logging.getLogger("harvester.cli")
 
@@ -155,6 +156,9 @@ def _fit_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--chains", type=int, default=CLI_TMCMC["chains"],
                    help=f"TMCMC chains ({CLI_TMCMC['chains']}; >= 2 for an evidence error)")
     p.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    p.add_argument("--start", choices=TMCMC_STARTS, default="map",
+                   help="where TMCMC's particles start: map (half at the model's MAP; "
+                        "default) or prior (all from the prior, as the paper's study)")
     p.add_argument("--lead-in", type=float, default=1.0, metavar="S",
                    help="seconds skipped before the likelihood (1.0; the model starts at rest)")
     p.add_argument("--fit-seconds", type=float, metavar="S",
@@ -342,7 +346,7 @@ def _settings(args: argparse.Namespace):
         raise DataError("<command line>", f"--particles {args.particles} and --chains "
                         f"{args.chains}: need at least 20 particles and 1 chain")
     return TMCMCSettings(particles=args.particles, chains=args.chains, seed=args.seed,
-                         mcmc_steps=CLI_TMCMC["mcmc_steps"],
+                         start=args.start, mcmc_steps=CLI_TMCMC["mcmc_steps"],
                          target_accept=CLI_TMCMC["target_accept"])
 
 

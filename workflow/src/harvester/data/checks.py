@@ -69,6 +69,7 @@ from scipy import signal
 
 from harvester.data.errors import DataError
 from harvester.data.recording import G, RecordingKinds, check_plausible
+from harvester.data.units import SI, Units
 
 #: Largest magnitude a column of each kind can hold (SI units): beyond any sensor's range.
 MAX_MAGNITUDE: dict[str, float] = {"base_acc": 1.0e5, "rel_acc": 1.0e5, "force": 1.0e8,
@@ -532,14 +533,17 @@ MAX_VELOCITY_RMS = 5.0
 
 def fast_displacements(df: pd.DataFrame, kinds: RecordingKinds, dt: float,
                        source: str | Path, known: Mapping[str, float] | None = None,
-                       known_from: str = "the sidecar") -> list[CheckWarning]:
+                       known_from: str = "the sidecar", units: Units = SI
+                       ) -> list[CheckWarning]:
     """A displacement column (rel_disp, base_disp) whose derivative
     (``harvester.data.kinds.derivative``, band-limited at the DAQ's edge) moves faster than
     MAX_VELOCITY_RMS: mm read as m. DataError for a mechanical device (its mass M or m known
     in kg, ``known``), which no rig moves that fast; a warning otherwise: a device known only
     through its recordings may be in other units (a circuit whose 'displacement' is a
-    voltage)."""
+    voltage). Nothing where the sidecar gives the displacement another unit (``units``)."""
     from harvester.data.kinds import derivative
+    if units.displacement != "m":
+        return []
     mechanical = bool({"M", "m"} & set(known or {}))
     out = []
     for name in (kinds.input_kind, kinds.output_kind):
@@ -592,12 +596,14 @@ def check_recording(df: pd.DataFrame, kinds: RecordingKinds, dt: float, source: 
                     known: Mapping[str, float] | None = None,
                     lines: Sequence[int] | None = None,
                     known_from: str = "the sidecar",
-                    lowpass_hz: float | None = None) -> list[CheckWarning]:
+                    lowpass_hz: float | None = None, units: Units = SI
+                    ) -> list[CheckWarning]:
     """Every check of a recording whose format is valid; returns the warnings.
 
     ``dt``: its time step (s); ``known``: the device's M, m, k where known (the sidecar's,
     named by ``known_from``), for the physics checks; ``lines``: file line of each row;
-    ``lowpass_hz``: a low-pass the output went through (the sidecar's filtered_at_hz).
+    ``lowpass_hz``: a low-pass the output went through (the sidecar's filtered_at_hz);
+    ``units``: the sidecar's (a displacement in volts is not judged as metres).
     Raises DataError for what cannot be right, in this order: absurd magnitudes, sampling
     rate, gravity left in or mm (``recording.check_plausible``), dead channels, saturation,
     a unit slip against the physics.
@@ -611,7 +617,7 @@ def check_recording(df: pd.DataFrame, kinds: RecordingKinds, dt: float, source: 
     found += flat_stretches(df, kinds, dt, source, lines)
     found += spikes(df, kinds, source, lines)
     found += drifting_base(df, kinds, dt, source)
-    found += fast_displacements(df, kinds, dt, source, known, known_from)
+    found += fast_displacements(df, kinds, dt, source, known, known_from, units)
     found += check_clock_against_device(dt, known, source, known_from)
     found += check_units_by_physics(df, kinds, dt, known, source, known_from, lowpass_hz)
     return found

@@ -547,7 +547,7 @@ def read_checked_recording(path: str | Path, known: Mapping[str, float] | None =
     dt, _ = _uniform_time(path, df, header, rows, lines)
     known = sidecar.known if known is None else known
     found = check_recording(df, kinds, dt, path, known, lines, known_from,
-                            sidecar.filtered_at_hz)
+                            sidecar.filtered_at_hz, sidecar.units)
     return CheckedRecording(df, kinds, dt, sidecar, found)
 
 

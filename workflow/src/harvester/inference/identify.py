@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import arviz as az
 
+from harvester.inference import TMCMC_STARTS
 from harvester.inference.likelihood import Problem
 from harvester.inference.posterior import set_known
 from harvester.inference.priors import PriorSpec, priors_for
@@ -16,8 +17,6 @@ from harvester.inference.tmcmc import Reference, run_tmcmc
 
 log = logging.getLogger("harvester.inference.identify")
 
-#: Where TMCMC's particles start (``TMCMCSettings.start``).
-STARTS = ("prior", "map")
 
 
 @dataclass(frozen=True)
@@ -38,8 +37,9 @@ class TMCMCSettings:
     start: str = "prior"
 
     def __post_init__(self) -> None:
-        if self.start not in STARTS:
-            raise ValueError(f"tmcmc start must be one of {STARTS}, got {self.start!r}")
+        if self.start not in TMCMC_STARTS:
+            raise ValueError(f"tmcmc start must be one of {TMCMC_STARTS}, got "
+                             f"{self.start!r}")
 
     @classmethod
     def from_config(cls, cfg: Mapping) -> "TMCMCSettings":
