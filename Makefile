@@ -9,14 +9,16 @@ STAMP   = $(VENV)/.installed
 .PHONY: study test test-slow emps detection benchmark dag clean-results
 
 # uv installs the pinned wheels in parallel: 19 s against pip's 75 s from a cold cache, .pyc
-# compiled (docs/measurements.md). It is only the installer; nothing imports it.
+# compiled (docs/measurements.md). It is only the installer; nothing imports it. Where it
+# cannot be had or cannot reach the index, pip installs the same pins.
 UV_PIN  = uv==0.13.9
+PIP     = $(BIN)/python -m pip install -q --disable-pip-version-check
 
 $(STAMP): requirements.txt pyproject.toml
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install -q --disable-pip-version-check $(UV_PIN)
-	$(BIN)/uv pip install -q --python $(BIN)/python --compile-bytecode -r requirements.txt
-	$(BIN)/uv pip install -q --python $(BIN)/python --no-deps --no-build-isolation -e .
+	($(PIP) $(UV_PIN) && $(BIN)/uv pip install -q --python $(BIN)/python --compile-bytecode \
+		-r requirements.txt) || (echo "uv failed: installing with pip" && $(PIP) -r requirements.txt)
+	$(PIP) --no-deps --no-build-isolation -e .
 	touch $@
 
 study: $(STAMP)
