@@ -35,6 +35,14 @@ def published_theta(problem, sigma: float = 2e-6) -> np.ndarray:
     return np.array([[ours[n] for n in problem.structure.free_parameters] + [sigma]])
 
 
+def broad_priors() -> dict[str, PriorSpec]:
+    """Priors of viscous + coulomb_friction centred away from the published values."""
+    broad = {"M": (90.0, 30.0, "kg", 0.0), "c_m": (150.0, 100.0, "N s/m", 0.0),
+             "F_offset": (0.0, 10.0, "N", -np.inf), "F_coulomb": (10.0, 20.0, "N", 0.0),
+             "sigma": (1e-5, 1e-5, "m", 0.0)}
+    return {n: PriorSpec(n, *v) for n, v in broad.items()}
+
+
 def sliced(record: emps.EmpsRecord, stop_s: float) -> emps.EmpsRecord:
     n = int(round(stop_s / record.dt))
     return emps.EmpsRecord(record.name, record.time[:n], record.qm[:n], record.qg[:n],
@@ -115,10 +123,7 @@ def test_map_fit_finds_the_published_friction(training) -> None:
     th = published_theta(p)
     sse, ok = p.residual_sums(th)
     assert ok[0] and np.isclose(np.sum(p.residuals(th) ** 2), sse[0], rtol=1e-9)
-    broad = {"M": (90.0, 30.0, "kg", 0.0), "c_m": (150.0, 100.0, "N s/m", 0.0),
-             "F_offset": (0.0, 10.0, "N", -np.inf), "F_coulomb": (10.0, 20.0, "N", 0.0),
-             "sigma": (1e-5, 1e-5, "m", 0.0)}
-    priors = {n: PriorSpec(n, *v) for n, v in broad.items()}
+    priors = broad_priors()
     fit = dict(zip(p.parameter_names, fit_map(p, priors, seed=0).theta))
     assert abs(fit["F_coulomb"] / emps.PUBLISHED["Fc"] - 1.0) < 0.1
     assert abs(fit["c_m"] / emps.PUBLISHED["Fv"] - 1.0) < 0.1
@@ -202,10 +207,7 @@ def test_map_start_gives_the_evidence_of_the_prior_start(training) -> None:
     evidence and posterior as from the prior, on 4 s of the record, in fewer stages."""
     rec = sliced(training, 4.0)
     p = emps.closed_loop_problem(rec, MODEL)
-    broad = {"M": (90.0, 30.0, "kg", 0.0), "c_m": (150.0, 100.0, "N s/m", 0.0),
-             "F_offset": (0.0, 10.0, "N", -np.inf), "F_coulomb": (10.0, 20.0, "N", 0.0),
-             "sigma": (1e-5, 1e-5, "m", 0.0)}
-    priors = {n: PriorSpec(n, *v) for n, v in broad.items()}
+    priors = broad_priors()
     runs = {start: identify(p, priors, TMCMCSettings(particles=150, chains=2, seed=3,
                                                      target_accept=0.25, start=start))
             for start in ("prior", "map")}
