@@ -9,7 +9,7 @@ import yaml
 from harvester.data.daq import read_raw_record, to_accelerations
 from harvester.inference.identify import TMCMCSettings, identify
 from harvester.inference.problems import make_problem
-from harvester.inference.posterior import posterior_theta
+from harvester.inference.posterior import adjusted_draws
 from harvester.inference.priors import prior_moments
 from harvester.data.signals import filter_recording
 
@@ -33,26 +33,22 @@ def tanh_posterior():
     return problem, identify(problem, priors, settings)
 
 
-#: How far the posterior sds of eq. (10) (2000 independent residuals) fall short of the
-#: estimates' scatter on the paper's session: the RMS of (estimate - truth) / sd over 10 draws
-#: of the mass channel's in-band error was 3.39, 3.16, 3.41 for c_m, F_c, beta
-#: (``python benchmarks/bench_rig_session.py --realizations 10``, docs/measurements.md): the
-#: 20 Hz low-pass correlates the residuals over about 6 samples.
-OVERCONFIDENCE = 3.5
-
-
-def test_tanh_model_recovers_rig_truth_within_widened_95_percent(tanh_posterior):
-    """The truth lies within the 95 % interval widened by the measured overconfidence of the
-    independent-residual likelihood (at the project's seed the plain interval misses F_c and
-    beta: docs/measurements.md, the virtual rig calibrated to the paper)."""
+def test_tanh_model_recovers_rig_truth_within_adjusted_95_percent(tanh_posterior):
+    """The truth lies within the 95 % interval adjusted for correlated residuals (eq. (10)'s
+    own interval misses F_c and beta at the project's seed: over 40 draws of the mass
+    channel's in-band error it held the truth 52-60 % of the time, the adjusted one 90-95 %:
+    ``python benchmarks/bench_rig_session.py --realizations 40``, docs/measurements.md)."""
     problem, idata = tanh_posterior
-    theta = posterior_theta(idata)
     truth = {"c_m": CONFIG["rig"]["c_m"], "F_c": CONFIG["rig"]["friction"]["F_c"],
              "beta": CONFIG["rig"]["friction"]["beta"]}
-    for i, name in enumerate(problem.parameter_names[:-1]):
-        mean, sd = theta[:, i].mean(), theta[:, i].std()
-        assert abs(mean - truth[name]) <= OVERCONFIDENCE * 1.96 * sd, \
-            f"{name}: truth {truth[name]}, posterior {mean:.4g} (sd {sd:.3g})"
+    adjusted = adjusted_draws(idata)
+    assert set(adjusted) == set(truth)
+    for name, x in adjusted.items():
+        low, high = np.quantile(x, [0.025, 0.975])
+        assert low <= truth[name] <= high, f"{name}: truth {truth[name]}, [{low:.4g}, {high:.4g}]"
+        plain = idata.posterior[name].values.reshape(-1)
+        assert x.mean() == pytest.approx(plain.mean(), rel=1e-9)
+        assert x.std() > 1.5 * plain.std()  # eq. (10)'s residuals are correlated over ~6
 
 
 def test_sigma_is_the_residual_of_the_true_parameters(tanh_posterior):

@@ -103,9 +103,15 @@ def full_dir(data_dir):
 def test_identification_tables_and_evidence(full_dir):
     for name in ("table3_linear.csv", "table5_tanh.csv"):
         t = pd.read_csv(full_dir / "results/tables" / name)
-        assert list(t.columns) == ["parameter", "mean", "sd", "q2.5", "q97.5", "paper", "truth"]
+        assert list(t.columns) == ["parameter", "mean", "sd", "q2.5", "q97.5", "sd_adj",
+                                   "q2.5_adj", "q97.5_adj", "paper", "truth"]
         assert np.all(t["q2.5"] <= t["mean"]) and np.all(t["mean"] <= t["q97.5"])
         assert np.all(t["sd"] > 0)
+        # the physical parameters' intervals for correlated residuals: stored by identify,
+        # no narrower than eq. (10)'s on the low-passed record; sigma's are not adjusted
+        phys = t[t.parameter != "sigma"]
+        assert np.all(phys["sd_adj"] >= phys["sd"]) and t.loc[t.parameter == "sigma",
+                                                               "sd_adj"].isna().all()
     post = az.from_netcdf(full_dir / "results/groups/paper/models/tanh/posterior.nc")
     t5 = pd.read_csv(full_dir / "results/tables/table5_tanh.csv").set_index("parameter")
     assert t5.loc["F_c", "mean"] == pytest.approx(post.posterior["F_c"].values.mean(), rel=1e-5)
@@ -150,6 +156,7 @@ def test_validation_table_content(full_dir):
         assert (full_dir / "results/figures" / name).stat().st_size > 10_000
     head = pd.read_csv(full_dir / "results/tables/headline.csv")
     assert head.quantity.str.contains("Bayes factor").any()
+    assert head.quantity.str.contains("adjusted for correlated residuals").sum() == 3
 
 
 def test_the_report_has_the_paper_pages_and_a_page_per_group(full_dir):

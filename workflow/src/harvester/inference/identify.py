@@ -9,8 +9,9 @@ from dataclasses import dataclass
 import arviz as az
 
 from harvester.inference import TMCMC_STARTS
+from harvester.inference import correlated_residuals
 from harvester.inference.likelihood import Problem
-from harvester.inference.posterior import set_known
+from harvester.inference.posterior import posterior_theta, set_known
 from harvester.inference.priors import PriorSpec, priors_for
 from harvester.inference.pymc_model import build_model
 from harvester.inference.tmcmc import Reference, run_tmcmc
@@ -60,7 +61,8 @@ def identify(problem: Problem, priors: Mapping[str, PriorSpec],
 
     ``reference``: temper from it instead of the prior (``harvester.inference.tmcmc.Reference``); its
     prior must be the one ``priors`` gives its variable. Without one, ``settings.start`` "map"
-    tempers from :func:`map_start`."""
+    tempers from :func:`map_start`. The draws' adjustment for correlated residuals
+    (``correlated_residuals``) is stored with them; the tables give both intervals."""
     if reference is None and settings.start == "map":
         reference = map_start(problem, priors, settings.seed)
     model = build_model(problem, priors)
@@ -77,6 +79,9 @@ def identify(problem: Problem, priors: Mapping[str, PriorSpec],
     idata.posterior.attrs["free_base"] = ",".join(problem.structure.free_base)
     idata.posterior.attrs["input_kind"] = problem.input_kind
     idata.posterior.attrs["output_kind"] = problem.output_kind
+    adjustment = correlated_residuals.correlation_adjustment(problem, posterior_theta(idata))
+    if adjustment is not None:
+        idata.posterior.attrs[correlated_residuals.ATTRIBUTE] = adjustment.to_json()
     return idata
 
 

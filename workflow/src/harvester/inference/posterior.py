@@ -19,7 +19,11 @@ if TYPE_CHECKING:
     import arviz as az
 
 #: Columns of the posterior tables (Tables 3 and 5).
-POSTERIOR_COLUMNS = ["parameter", "mean", "sd", "q2.5", "q97.5", "paper", "truth"]
+POSTERIOR_COLUMNS = ["parameter", "mean", "sd", "q2.5", "q97.5", "sd_adj", "q2.5_adj",
+                     "q97.5_adj", "paper", "truth"]
+
+#: The columns of an interval for correlated residuals (:func:`interval_columns`).
+ADJUSTED_COLUMNS = ("sd_adj", "q2.5_adj", "q97.5_adj")
 
 
 @dataclass(frozen=True)
@@ -66,17 +70,39 @@ def parameter_names(idata: az.InferenceData) -> list[str]:
     return [n for n in names if n]
 
 
+def adjusted_draws(idata: az.InferenceData) -> dict[str, np.ndarray]:
+    """The physical parameters' draws adjusted for correlated residuals, by name (the
+    adjustment ``identify`` stored; empty when there is none)."""
+    from harvester.inference.correlated_residuals import ATTRIBUTE, Adjustment
+    text = idata.posterior.attrs.get(ATTRIBUTE)
+    if not text:
+        return {}
+    adj = Adjustment.from_json(str(text))
+    x = adj.apply(samples(idata, adj.names))
+    return {name: x[:, j] for j, name in enumerate(adj.names)}
+
+
+def interval_columns(x: np.ndarray, adjusted: np.ndarray | None) -> dict[str, float]:
+    """mean, sd, 95 % interval of draws x (eq. (10)'s posterior) and, where given, the sd and
+    95 % interval of the same draws adjusted for correlated residuals (NaN where not)."""
+    out = {"mean": x.mean(), "sd": x.std(ddof=1) if x.size > 1 else np.nan,
+           "q2.5": np.quantile(x, 0.025), "q97.5": np.quantile(x, 0.975)}
+    a = adjusted if adjusted is not None else np.full(2, np.nan)
+    out.update(zip(ADJUSTED_COLUMNS, (a.std(ddof=1), np.quantile(a, 0.025),
+                                      np.quantile(a, 0.975))))
+    return out
+
+
 def summary_table(idata: az.InferenceData, paper: dict[str, float],
                   truth: dict[str, float]) -> pd.DataFrame:
-    """Posterior mean, sd and 95% interval of each parameter beside the paper's and the truth."""
+    """Posterior mean, sd and 95% interval of each parameter (eq. (10)'s, and adjusted for
+    correlated residuals) beside the paper's and the truth."""
+    adjusted = adjusted_draws(idata)
     rows = []
     for name in parameter_names(idata):
         x = idata.posterior[name].values.reshape(-1)
-        rows.append({
-            "parameter": name, "mean": x.mean(), "sd": x.std(ddof=1),
-            "q2.5": np.quantile(x, 0.025), "q97.5": np.quantile(x, 0.975),
-            "paper": paper.get(name, np.nan), "truth": truth.get(name, np.nan),
-        })
+        rows.append({"parameter": name, **interval_columns(x, adjusted.get(name)),
+                     "paper": paper.get(name, np.nan), "truth": truth.get(name, np.nan)})
     return pd.DataFrame(rows, columns=POSTERIOR_COLUMNS)
 
 

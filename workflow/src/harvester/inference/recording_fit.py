@@ -26,14 +26,16 @@ from harvester.data.signals import uniform_step
 from harvester.inference.identify import TMCMCSettings, identify
 from harvester.inference.problems import make_problem
 from harvester.inference.likelihood import Problem
-from harvester.inference.posterior import (log_evidence, parameter_names, posterior_theta,
+from harvester.inference.posterior import (adjusted_draws, interval_columns, log_evidence,
+                                          parameter_names, posterior_theta,
                                           pooled_log_evidence)
 from harvester.inference.priors import PriorSpec
 
 log = logging.getLogger("harvester.inference.recording_fit")
 
 #: Columns of summary.csv.
-SUMMARY_COLUMNS = ["parameter", "unit", "mean", "sd", "q2.5", "q97.5", "prior"]
+SUMMARY_COLUMNS = ["parameter", "unit", "mean", "sd", "q2.5", "q97.5", "sd_adj", "q2.5_adj",
+                   "q97.5_adj", "prior"]
 #: Seconds at the end of a low-passed record left out of the likelihood (the zero-phase
 #: filter's end effects).
 END_EFFECTS_S = 0.5
@@ -78,14 +80,15 @@ def recording_problem(df: pd.DataFrame, model: str, known: Mapping[str, float],
 
 
 def parameter_table(idata: az.InferenceData, priors: Mapping[str, PriorSpec]) -> pd.DataFrame:
-    """Posterior mean, sd and 95 % interval of each parameter, with its unit and prior."""
+    """Posterior mean, sd and 95 % interval of each parameter (eq. (10)'s, and adjusted for
+    correlated residuals: ``*_adj``), with its unit and prior."""
+    adjusted = adjusted_draws(idata)
     rows = []
     for name in parameter_names(idata):
         x = idata.posterior[name].values.reshape(-1)
         spec = priors.get(name)
-        rows.append({"parameter": name, "unit": spec.unit if spec else "", "mean": x.mean(),
-                     "sd": x.std(ddof=1) if x.size > 1 else np.nan,
-                     "q2.5": np.quantile(x, 0.025), "q97.5": np.quantile(x, 0.975),
+        rows.append({"parameter": name, "unit": spec.unit if spec else "",
+                     **interval_columns(x, adjusted.get(name)),
                      "prior": spec.describe() if spec else ""})
     return pd.DataFrame(rows, columns=SUMMARY_COLUMNS)
 

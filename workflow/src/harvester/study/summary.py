@@ -23,6 +23,7 @@ def headline_table(table1: pd.DataFrame, posteriors: Mapping[str, pd.DataFrame],
         rows += [{"quantity": f"{number} ({model}): posterior mean {r.parameter}",
                   "paper": r.paper, "ours": r.mean, "truth": r.truth, "unit": ""}
                  for r in df.itertuples()]
+        rows += _interval_rows(number, model, df)
     for r in bayes.itertuples():
         rows.append({"quantity": f"eq. (12): log Bayes factor {r.model} / {r.reference} "
                                  f"(sd over chains {r.sd_over_chains:.2f})",
@@ -33,6 +34,22 @@ def headline_table(table1: pd.DataFrame, posteriors: Mapping[str, pd.DataFrame],
                      "paper": paper.OUTSIDE_3SIGMA_UNSEEN if r.bounds == "parameter" else np.nan,
                      "ours": r.outside_3sigma, "truth": np.nan, "unit": "fraction"})
     return pd.DataFrame(rows, columns=COLUMNS)
+
+
+def _interval_rows(number: str, model: str, df: pd.DataFrame) -> list[dict]:
+    """Where the rig's truth is known: the 95 % intervals of eq. (10) and adjusted for
+    correlated residuals (``inference.correlated_residuals``), the truth beside them."""
+    rows = []
+    for r in df.to_dict("records"):
+        if not np.isfinite(r["truth"]):
+            continue
+        adjusted = (f"[{r['q2.5_adj']:.4g}, {r['q97.5_adj']:.4g}]"
+                    if np.isfinite(r.get("sd_adj", np.nan)) else "none stored")
+        rows.append({"quantity": f"{number} ({model}): 95 % interval of {r['parameter']}, "
+                                 "eq. (10) / adjusted for correlated residuals",
+                     "paper": np.nan, "ours": f"[{r['q2.5']:.4g}, {r['q97.5']:.4g}] / {adjusted}",
+                     "truth": r["truth"], "unit": ""})
+    return rows
 
 
 def _cell(x: object) -> str:

@@ -1,0 +1,167 @@
+"""Posterior intervals that hold when the residuals are correlated in time.
+
+Eq. (10) counts every residual as independent. A low-passed record's residuals are not: at
+256 Hz after the study's 20 Hz low-pass they are correlated over about 6 samples, and on the
+virtual rig the posterior sds of eq. (10) fell 2.5-3 x short of the estimates' scatter over
+40 draws of the sensor error (docs/measurements.md, "Intervals for correlated residuals").
+
+The adjustment keeps eq. (10)'s posterior (its mean, the evidence, the tables' means) and
+rescales its draws about their mean, the curvature adjustment of Ribatet, Cooley and Davison
+(2012, Statistica Sinica 22, 813-845) for a misspecified likelihood:
+
+* the working likelihood's curvature is H = J^T J / sigma^2 (J the model output's Jacobian on
+  the fitted samples at the posterior mean, Gauss-Newton);
+* the variance of its score is V = J^T R J / sigma^4, R the residuals' covariance: a Toeplitz
+  matrix of their autocovariance, tapered by a Bartlett window out to a lag chosen by Sokal's
+  automatic window (5 x the integrated autocorrelation time);
+* the estimate's covariance is then the sandwich H^-1 V H^-1, and the adjusted posterior
+  precision is the prior's part of the posterior precision plus H V^-1 H.
+
+With white residuals V = H and nothing changes. Only the physical parameters are adjusted;
+sigma's draws are left as they are.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+from dataclasses import asdict, dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:  # the tables read an Adjustment without the simulator's import
+    from harvester.inference.likelihood import Problem
+
+log = logging.getLogger("harvester.inference.correlated_residuals")
+
+#: The posterior attribute (JSON) that holds an :class:`Adjustment`.
+ATTRIBUTE = "correlated_residuals"
+
+#: Sokal's window: the autocovariance is summed out to the first lag M >= SOKAL_C x tau(M).
+SOKAL_C = 5.0
+MIN_LAG = 10
+
+#: Finite-difference step of the Jacobian, in posterior sds.
+STEP_SDS = 0.05
+
+
+@dataclass(frozen=True)
+class Adjustment:
+    """theta_adjusted = center + matrix (theta - center), for the physical parameters ``names``.
+
+    ``tau``: the residuals' integrated autocorrelation time (samples); ``max_lag``: the last
+    lag of their autocovariance used; ``inflation``: adjusted sd / eq. (10)'s sd per parameter.
+    """
+
+    names: tuple[str, ...]
+    center: tuple[float, ...]
+    matrix: tuple[tuple[float, ...], ...]
+    tau: float
+    max_lag: int
+    inflation: tuple[float, ...]
+
+    def apply(self, theta: np.ndarray) -> np.ndarray:
+        """Adjusted draws (rows of the physical parameters in ``names`` order)."""
+        c = np.asarray(self.center)
+        return c + (np.atleast_2d(theta) - c) @ np.asarray(self.matrix).T
+
+    def to_json(self) -> str:
+        return json.dumps(asdict(self))
+
+    @classmethod
+    def from_json(cls, text: str) -> "Adjustment":
+        d = json.loads(text)
+        return cls(names=tuple(d["names"]), center=tuple(d["center"]),
+                   matrix=tuple(tuple(r) for r in d["matrix"]), tau=float(d["tau"]),
+                   max_lag=int(d["max_lag"]), inflation=tuple(d["inflation"]))
+
+
+def autocovariance(r: np.ndarray, max_lag: int) -> np.ndarray:
+    """Biased autocovariance of r (mean removed) at lags 0..max_lag."""
+    r = np.asarray(r, dtype=float) - np.mean(r)
+    n = r.size
+    spec = np.fft.rfft(r, 2 * n)
+    return np.fft.irfft(spec * np.conj(spec))[:max_lag + 1] / n
+
+
+def sokal_window(r: np.ndarray) -> tuple[float, int]:
+    """(integrated autocorrelation time tau in samples, window M): the first M with
+    M >= SOKAL_C tau(M), tau(M) = 1 + 2 sum_{k<=M} rho_k (Sokal 1997); M at least MIN_LAG and
+    at most a tenth of the record."""
+    cap = max(MIN_LAG, r.size // 10)
+    rho = autocovariance(r, cap)
+    rho = rho / rho[0]
+    tau = 1.0 + 2.0 * np.cumsum(rho[1:])
+    lags = np.arange(1, cap + 1)
+    hit = np.nonzero(lags >= SOKAL_C * tau)[0]
+    m = int(lags[hit[0]]) if hit.size else cap
+    return float(max(tau[m - 1], 1.0 / r.size)), max(m, MIN_LAG)
+
+
+def sandwich(jac: np.ndarray, r: np.ndarray, max_lag: int) -> tuple[np.ndarray, np.ndarray]:
+    """(H, V) of the Gaussian working likelihood with sigma^2 = mean(r^2): H = J^T J / s^2,
+    V = J^T R J / s^4, R Toeplitz in r's autocovariance with a Bartlett taper to ``max_lag``.
+    jac: (n, p) derivative of the model output on the fitted samples."""
+    s2 = float(np.mean(np.square(r)))
+    gam = autocovariance(r, max_lag)
+    jtj = jac.T @ jac
+    v = gam[0] * jtj
+    for k in range(1, max_lag + 1):
+        g = jac[k:].T @ jac[:-k]
+        v += (1.0 - k / (max_lag + 1.0)) * gam[k] * (g + g.T)
+    return jtj / s2, v / s2 ** 2
+
+
+def adjustment_matrix(post_cov: np.ndarray, h: np.ndarray, v: np.ndarray,
+                      temper: float = 1.0) -> np.ndarray:
+    """C with C post_cov C^T = the adjusted posterior covariance: the posterior precision less
+    the working likelihood's curvature (temper x H: the prior's part, kept; clipped at zero)
+    plus H V^-1 H (Ribatet et al. 2012's curvature adjustment)."""
+    prec = np.linalg.inv(post_cov)
+    prior_part = prec - temper * h
+    w, q = np.linalg.eigh(0.5 * (prior_part + prior_part.T))
+    prior_part = (q * np.clip(w, 0.0, None)) @ q.T
+    adj_prec = prior_part + h @ np.linalg.solve(v, h)
+    adj_cov = np.linalg.inv(0.5 * (adj_prec + adj_prec.T))
+    return np.linalg.cholesky(adj_cov) @ np.linalg.inv(np.linalg.cholesky(post_cov))
+
+
+def output_jacobian(problem: Problem, center: np.ndarray, steps: np.ndarray,
+                    sigma: float) -> tuple[np.ndarray, np.ndarray]:
+    """(residual at center (n,), derivative of the residual (n, p)) on the likelihood's samples,
+    central differences in one batched simulation; NaN rows where a simulation failed."""
+    p = center.size
+    rows = np.repeat(center[None, :], 2 * p + 1, axis=0)
+    rows[1:p + 1][np.arange(p), np.arange(p)] += steps
+    rows[p + 1:][np.arange(p), np.arange(p)] -= steps
+    r = problem.residuals(np.column_stack([rows, np.full(len(rows), sigma)]))
+    return r[0], ((r[1:p + 1] - r[p + 1:]) / (2.0 * steps[:, None])).T
+
+
+def correlation_adjustment(problem: Problem, theta: np.ndarray) -> Adjustment | None:
+    """The adjustment of posterior draws ``theta`` (rows: the problem's parameters, sigma last)
+    for the residuals' correlation; None (logged) where the Jacobian cannot be formed (a failed
+    simulation) or the posterior has a single draw."""
+    names = problem.parameter_names[:-1]
+    x = np.asarray(theta, dtype=float)[:, :len(names)]
+    if x.shape[0] < 2 * len(names) + 2 or not names:
+        return None
+    center, cov = x.mean(axis=0), np.atleast_2d(np.cov(x, rowvar=False))
+    sd = np.sqrt(np.diag(cov))
+    sigma = float(np.mean(np.asarray(theta)[:, -1]))
+    r, jac = output_jacobian(problem, center, STEP_SDS * np.where(sd > 0, sd, 1e-12), sigma)
+    if not (np.all(np.isfinite(r)) and np.all(np.isfinite(jac))):
+        log.warning("%s: no interval adjustment for correlated residuals (a simulation near "
+                    "the posterior mean failed)", problem.structure.name)
+        return None
+    tau, lag = sokal_window(r)
+    h, v = sandwich(jac, r, lag)
+    mat = adjustment_matrix(cov, h, v, problem.temper)
+    inflation = np.sqrt(np.diag(mat @ cov @ mat.T)) / sd
+    log.info("%s: residuals correlated over tau = %.1f samples (lags to %d); intervals for "
+             "correlated residuals %s x eq. (10)'s", problem.structure.name, tau, lag,
+             ", ".join(f"{n} {f:.2f}" for n, f in zip(names, inflation)))
+    return Adjustment(tuple(names), tuple(map(float, center)),
+                      tuple(tuple(map(float, row)) for row in mat), tau, lag,
+                      tuple(map(float, inflation)))
