@@ -172,8 +172,10 @@ def test_parameter_and_evidence_tables() -> None:
              for name, our in emps.PARAMETERS.items()}
     idata = fake_idata(draws, [10.0, 10.2])
     table = emps.parameters_table(idata)
-    assert list(table.columns) == ["parameter", "mean", "sd", "q2.5", "q97.5", "published"]
+    assert list(table.columns) == ["parameter", "mean", "sd", "q2.5", "q97.5", "sd_adj",
+                                   "q2.5_adj", "q97.5_adj", "published"]
     assert list(table["parameter"]) == ["M", "Fv", "Fc", "offset"]
+    assert table["sd_adj"].isna().all()  # no adjustment stored with these draws
     comparison = emps.comparison_table(table, emps.PUBLISHED)
     assert comparison["within_tolerance"].all() and (comparison["idim_ls_error_pct"] == 0).all()
     runs = {"viscous": fake_idata({"M": draws["M"]}, [5.0, 5.0]),
