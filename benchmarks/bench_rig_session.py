@@ -48,7 +48,7 @@ import yaml
 from scipy import optimize
 
 from harvester.data import daq
-from harvester.inference.correlated_residuals import adjustment_matrix, sandwich, sokal_window
+from harvester.inference.correlated_residuals import adjustment_matrix, sandwich, lag_window
 from harvester.data.signals import filter_recording
 from harvester.inference.recording_fit import FitWindow, recording_problem
 from harvester.synthetic import rig
@@ -108,7 +108,7 @@ def fit(problem, model: str) -> dict:
     jac = np.array(jac).T
     hess = jac.T @ jac / sigma ** 2
     cov = np.linalg.inv(hess)
-    _, lag = sokal_window(problem.observed - y0)
+    _, lag = lag_window(problem.observed - y0)
     mat = adjustment_matrix(cov, *sandwich(jac, problem.observed - y0, lag))
     return {"x": x, "sigma": sigma, "cov": cov, "hess": hess, "n": n,
             "cov_adj": mat @ cov @ mat.T,

@@ -6,7 +6,7 @@ import pytest
 from scipy import signal
 
 from harvester.inference.correlated_residuals import (Adjustment, adjustment_matrix, sandwich,
-                                                      sokal_window)
+                                                      lag_window)
 
 N = 2000
 FS, CUTOFF = 256.0, 20.0
@@ -46,7 +46,7 @@ def test_sandwich_matches_the_exact_covariance_where_eq10_falls_short(regression
         e = lowpassed(rng, N)
         beta = np.linalg.lstsq(x, e, rcond=None)[0]  # the truth is 0
         r = e - x @ beta
-        _, lag = sokal_window(r)
+        _, lag = lag_window(r)
         h, v = sandwich(x, r, lag)
         cov = np.linalg.inv(h) @ v @ np.linalg.inv(h)
         ratios.append(np.sqrt(np.diag(cov) / np.diag(exact)))
@@ -58,15 +58,21 @@ def test_sandwich_matches_the_exact_covariance_where_eq10_falls_short(regression
 
 
 def test_white_residuals_leave_the_posterior_unchanged():
+    """Over 20 draws of white residuals the adjusted sds average eq. (10)'s within 5 % (one
+    draw scatters by about 10 %: the taper's 50 lags of sampled autocovariance)."""
     rng = np.random.default_rng(3)
     x = np.column_stack([lowpassed(rng, N, 8.0), np.ones(N)])
-    r = 0.1 * rng.standard_normal(N)
-    tau, lag = sokal_window(r)
-    h, v = sandwich(x, r, lag)
-    post = np.linalg.inv(h)
-    mat = adjustment_matrix(post, h, v)
-    assert tau == pytest.approx(1.0, abs=0.2)
-    assert np.sqrt(np.diag(mat @ post @ mat.T) / np.diag(post)) == pytest.approx([1, 1], abs=0.1)
+    taus, ratios = [], []
+    for _ in range(20):
+        r = 0.1 * rng.standard_normal(N)
+        tau, lag = lag_window(r)
+        h, v = sandwich(x, r, lag)
+        post = np.linalg.inv(h)
+        mat = adjustment_matrix(post, h, v)
+        taus.append(tau)
+        ratios.append(np.sqrt(np.diag(mat @ post @ mat.T) / np.diag(post)))
+    assert np.mean(taus) == pytest.approx(1.0, abs=0.1)
+    assert np.mean(ratios, axis=0) == pytest.approx([1, 1], abs=0.05)
 
 
 def test_the_prior_part_of_the_posterior_is_kept():

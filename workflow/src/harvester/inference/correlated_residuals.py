@@ -12,8 +12,10 @@ rescales its draws about their mean, the curvature adjustment of Ribatet, Cooley
 * the working likelihood's curvature is H = J^T J / sigma^2 (J the model output's Jacobian on
   the fitted samples at the posterior mean, Gauss-Newton);
 * the variance of its score is V = J^T R J / sigma^4, R the residuals' covariance: a Toeplitz
-  matrix of their autocovariance, tapered by a Bartlett window out to a lag chosen by Sokal's
-  automatic window (5 x the integrated autocorrelation time);
+  matrix of their autocovariance, tapered by a Bartlett window out to a lag of at least 4
+  n^(1/3) (Andrews 1991's rate for that window) and at least Sokal's automatic window (5 x the
+  integrated autocorrelation time): a residual that rings (the Silverbox's, at 200 Hz) has an
+  autocorrelation that Sokal's sum reads as short;
 * the estimate's covariance is then the sandwich H^-1 V H^-1, and the adjusted posterior
   precision is the prior's part of the posterior precision plus H V^-1 H.
 
@@ -25,6 +27,7 @@ from __future__ import annotations
 
 import json
 import logging
+import math
 from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING
 
@@ -41,6 +44,9 @@ ATTRIBUTE = "correlated_residuals"
 #: Sokal's window: the autocovariance is summed out to the first lag M >= SOKAL_C x tau(M).
 SOKAL_C = 5.0
 MIN_LAG = 10
+
+#: The Bartlett taper reaches at least LAG_RATE x n^(1/3) lags.
+LAG_RATE = 4.0
 
 #: Finite-difference step of the Jacobian, in posterior sds.
 STEP_SDS = 0.05
@@ -99,6 +105,14 @@ def sokal_window(r: np.ndarray) -> tuple[float, int]:
     return float(max(tau[m - 1], 1.0 / r.size)), max(m, MIN_LAG)
 
 
+def lag_window(r: np.ndarray) -> tuple[float, int]:
+    """(tau, the Bartlett taper's last lag): Sokal's window, at least LAG_RATE n^(1/3) lags,
+    at most a tenth of the record."""
+    tau, m = sokal_window(r)
+    floor = math.ceil(LAG_RATE * r.size ** (1.0 / 3.0))
+    return tau, min(max(m, floor), max(MIN_LAG, r.size // 10))
+
+
 def sandwich(jac: np.ndarray, r: np.ndarray, max_lag: int) -> tuple[np.ndarray, np.ndarray]:
     """(H, V) of the Gaussian working likelihood with sigma^2 = mean(r^2): H = J^T J / s^2,
     V = J^T R J / s^4, R Toeplitz in r's autocovariance with a Bartlett taper to ``max_lag``.
@@ -155,13 +169,13 @@ def correlation_adjustment(problem: Problem, theta: np.ndarray) -> Adjustment | 
         log.warning("%s: no interval adjustment for correlated residuals (a simulation near "
                     "the posterior mean failed)", problem.structure.name)
         return None
-    tau, lag = sokal_window(r)
+    tau, lag = lag_window(r)
     h, v = sandwich(jac, r, lag)
     mat = adjustment_matrix(cov, h, v, problem.temper)
     inflation = np.sqrt(np.diag(mat @ cov @ mat.T)) / sd
-    log.info("%s: residuals correlated over tau = %.1f samples (lags to %d); intervals for "
-             "correlated residuals %s x eq. (10)'s", problem.structure.name, tau, lag,
-             ", ".join(f"{n} {f:.2f}" for n, f in zip(names, inflation)))
+    log.info("%s: residuals' integrated autocorrelation time %.2g samples (lags to %d); "
+             "intervals for correlated residuals %s x eq. (10)'s", problem.structure.name, tau,
+             lag, ", ".join(f"{n} {f:.2f}" for n, f in zip(names, inflation)))
     return Adjustment(tuple(names), tuple(map(float, center)),
                       tuple(tuple(map(float, row)) for row in mat), tau, lag,
                       tuple(map(float, inflation)))
