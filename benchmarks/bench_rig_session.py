@@ -12,6 +12,11 @@ line per setting:
   of them at which the rig sticks;
 * ``linear_c_m``, ``linear_sigma``, ``tanh`` (c_m, F_c, beta), ``tanh_sigma``: the least-squares
   estimates (sigma = RMS residual: the posterior means of Tables 3 and 5 up to the priors);
+* ``sticks``, ``longest_stick_ms``, ``near_stick_pct`` (within 20 ms of a stick) and, per
+  model, ``*_rms_near_over_elsewhere``: its RMS residual near the sticks over elsewhere, and
+  ``*_nrmse_near_over_elsewhere`` the same of the residual relative to the measured output's
+  RMS there (``measured_rms_near_over_elsewhere``): Figure 7's claim that the linear model
+  fails where the device sticks reads > 1;
 * ``tanh_sd``: their posterior sds by Laplace (Gauss-Newton Hessian), ``tanh_z``: (estimate -
   truth) / sd, the truth being the rig's Table 5 values; ``tanh_z_adj`` the same with the sds
   adjusted for correlated residuals (``inference.correlated_residuals``, flat priors);
@@ -111,6 +116,7 @@ def fit(problem, model: str) -> dict:
     _, lag = lag_window(problem.observed - y0)
     mat = adjustment_matrix(cov, *sandwich(jac, problem.observed - y0, lag))
     return {"x": x, "sigma": sigma, "cov": cov, "hess": hess, "n": n,
+            "residual": problem.observed - y0,
             "cov_adj": mat @ cov @ mat.T,
             "names": problem.structure.free_parameters, "problem": problem}
 
@@ -125,6 +131,35 @@ def laplace_log_evidence(f: dict, priors: dict) -> float:
     d = f["x"].size + 1
     log_det = np.linalg.slogdet(f["hess"])[1] + math.log(2.0 * n / sigma ** 2)
     return log_l + log_p + 0.5 * d * math.log(2.0 * math.pi) - 0.5 * log_det
+
+
+def stick_statistics(stuck: np.ndarray, fits: dict, fs: float = 256.0,
+                     near_s: float = 0.02) -> dict:
+    """Figure 7's question: the rig's sticks over the fitted samples (count, longest) and
+    each model's RMS residual within ``near_s`` of a stick over its RMS elsewhere."""
+    edges = np.diff(np.r_[0, stuck.astype(int), 0])
+    starts, ends = np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0]
+    pad = int(round(near_s * fs))
+    near = np.zeros(stuck.size, dtype=bool)
+    for a, b in zip(starts, ends):
+        near[max(a - pad, 0):b + pad] = True
+    out = {"sticks": int(starts.size),
+           "longest_stick_ms": round(1e3 * float((ends - starts).max(initial=0)) / fs, 1),
+           "near_stick_pct": round(100.0 * float(near.mean()), 2)}
+    if not (near.any() and (~near).any()):
+        return out
+    y = next(iter(fits.values()))["problem"].observed
+
+    def rms(x, mask):
+        return float(np.sqrt(np.mean(x[mask] ** 2)))
+
+    out["measured_rms_near_over_elsewhere"] = round(rms(y, near) / rms(y, ~near), 3)
+    for model, f in fits.items():
+        r = f["residual"]
+        out[f"{model}_rms_near_over_elsewhere"] = round(rms(r, near) / rms(r, ~near), 3)
+        out[f"{model}_nrmse_near_over_elsewhere"] = round(
+            rms(r, near) / rms(y, near) / (rms(r, ~near) / rms(y, ~near)), 3)
+    return out
 
 
 def analyse(cfg: dict, rc: dict, args, unseen: bool) -> dict:
@@ -154,7 +189,8 @@ def analyse(cfg: dict, rc: dict, args, unseen: bool) -> dict:
            "tanh_sigma": round(t["sigma"], 4),
            "log_bf_laplace": round(laplace_log_evidence(t, priors)
                                    - laplace_log_evidence(fits["linear"], priors), 1),
-           "n_log_sigma_ratio": round(t["n"] * math.log(fits["linear"]["sigma"] / t["sigma"]), 1)}
+           "n_log_sigma_ratio": round(t["n"] * math.log(fits["linear"]["sigma"] / t["sigma"]), 1),
+           **stick_statistics(sim.truth["stuck"][lead:lead + n_fit], fits)}
     if unseen:
         simv, val = filtered_record(rc, "validation", pre)
         rng = np.random.default_rng(11)
