@@ -91,7 +91,8 @@ COMMAND_TEXTS: dict[str, tuple[str, str, str]] = {
     "identify": ("identify one model structure by TMCMC",
                  "harvester identify rec.csv --model tanh+cubic_stiffness --out fit",
                  "writes DIR/posterior.nc, summary.csv (parameter, unit, mean, sd, 2.5 and 97.5 "
-                 "%), evidence.json (log evidence in nats per chain, pooled, standard error), "
+                 "%, and the same adjusted for correlated residuals), evidence.json (log "
+                 "evidence in nats per chain, pooled, standard error), "
                  "posterior_pairs.png, run.json (known, assumed, priors, warnings)"),
     "compare": ("identify several structures; evidence and Bayes factors",
                 "harvester compare rec.csv --models linear tanh --out cmp",
