@@ -21,9 +21,10 @@ $(STAMP): requirements.txt pyproject.toml
 	$(PIP) --no-deps --no-build-isolation -e .
 	touch $@
 
-# The longest chain (the paper's tanh posterior, then the electrical half and the power) is
-# scheduled first, so that the last minute does not run one job on two cores.
-CRITICAL = results/electrical/weights.json
+# The longest chains (the paper's tanh posterior, then the electrical half and the power; its
+# linear posterior, then that model's diagnosis) are scheduled first, so that the last minute
+# does not run one job on two cores.
+CRITICAL = results/electrical/weights.json results/groups/paper/diagnosis/linear/summary.html
 
 study: $(STAMP)
 	$(BIN)/snakemake --cores $(CORES) all emps_all --prioritize $(CRITICAL)

@@ -47,6 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from harvester.emps.data import EmpsRecord, ServoLoop, disturbance_voltage
+from harvester.inference.correlated_residuals import sokal_window
 from harvester.inference.likelihood import Problem
 from harvester.model.simulate import Simulation, run_servo
 from harvester.model.structures import Layout, ModelStructure
@@ -180,20 +181,14 @@ def closed_loop_fit(problem: ClosedLoopProblem, start: Mapping[str, float]
     return values, problem.output - pred
 
 
-def correlation_time(x: np.ndarray, c: float = 5.0) -> float:
-    """Integrated autocorrelation time tau = 1 + 2 sum_k rho(k) (samples), Sokal's window.
+def correlation_time(x: np.ndarray) -> float:
+    """Integrated autocorrelation time tau = 1 + 2 sum_k rho(k) (samples), Sokal's window
+    (``inference.correlated_residuals.sokal_window``), at least 1.
 
     tau correlated samples are worth one independent one: eq. (10) on them counts each piece
     of information tau times, so the likelihood is tempered by 1 / tau.
     """
-    x = np.asarray(x, dtype=float) - np.mean(x)
-    f = np.fft.rfft(x, n=2 * x.size)
-    acf = np.fft.irfft(f * np.conj(f))[: x.size]
-    if acf[0] <= 0:
-        return 1.0
-    taus = 2.0 * np.cumsum(acf / acf[0]) - 1.0
-    ok = np.arange(x.size) >= c * taus
-    return float(max(taus[int(np.argmax(ok)) if ok.any() else -1], 1.0))
+    return max(sokal_window(np.asarray(x, dtype=float))[0], 1.0)
 
 
 def temper_from(residual: np.ndarray, stride: int) -> tuple[float, float]:
