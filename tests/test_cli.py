@@ -247,6 +247,11 @@ def test_identify_writes_posterior_summary_evidence_and_assumptions(bundled_fit)
     assert list(summary.parameter) == ["c_m", "sigma"]
     assert list(summary.unit) == ["N s/m", "m/s^2"]
     assert (summary["q2.5"] <= summary["mean"]).all() and (summary["mean"] <= summary["q97.5"]).all()
+    # the low-passed record's residuals are correlated: c_m's adjusted interval is wider, and
+    # the command prints both
+    c_m = summary.set_index("parameter").loc["c_m"]
+    assert c_m["sd_adj"] > c_m["sd"]
+    assert "c_m = " in said and "for correlated residuals" in said
     ev = json.loads((out / "evidence.json").read_text())
     assert len(ev["log_evidence_per_chain"]) == 2 and ev["standard_error"] > 0
     assert np.isfinite(ev["log_evidence"])

@@ -403,7 +403,7 @@ def _fit_record(problem, priors, notes, settings) -> dict:
 
 def identify_command(args: argparse.Namespace) -> int:
     from harvester.data.fileio import atomic_directory, check_output_dir, write_json
-    from harvester.inference.recording_fit import fit_recording
+    from harvester.inference.recording_fit import fit_recording, interval_lines, parameter_table
     check_output_dir(args.out, inputs=(args.recording,))
     settings = _settings(args)
     checked, kp = _read(args.recording, args.paper_device, for_model=True)
@@ -418,6 +418,7 @@ def identify_command(args: argparse.Namespace) -> int:
     print(f"{args.model}: log evidence {ev['log_evidence']:.2f}"
           + (f" +- {ev['standard_error']:.2f}" if ev["standard_error"] else "")
           + f" -> {args.out}")
+    print("\n".join(interval_lines(parameter_table(fit.idata, fit.priors))))
     return 0
 
 
@@ -426,7 +427,7 @@ def compare_command(args: argparse.Namespace) -> int:
 
     from harvester.data.fileio import atomic_directory, check_output_dir, write_json
     from harvester.inference.compare import evidence_table, verdict
-    from harvester.inference.recording_fit import fit_recording
+    from harvester.inference.recording_fit import fit_recording, interval_lines, parameter_table
     check_output_dir(args.out, inputs=(args.recording,))
     if len(set(args.models)) != len(args.models):
         raise DataError("<command line>", f"--models repeats a model: {args.models}")

@@ -93,6 +93,19 @@ def parameter_table(idata: az.InferenceData, priors: Mapping[str, PriorSpec]) ->
     return pd.DataFrame(rows, columns=SUMMARY_COLUMNS)
 
 
+def interval_lines(table: pd.DataFrame) -> list[str]:
+    """One line per parameter of a :func:`parameter_table`: its mean and 95 % interval, and
+    where stored the interval adjusted for correlated residuals."""
+    lines = []
+    for r in table.to_dict("records"):
+        line = (f"  {r['parameter']} = {r['mean']:.5g} {r['unit']}".rstrip()
+                + f", 95 % [{r['q2.5']:.5g}, {r['q97.5']:.5g}]")
+        if np.isfinite(r["sd_adj"]):
+            line += f"; for correlated residuals [{r['q2.5_adj']:.5g}, {r['q97.5_adj']:.5g}]"
+        lines.append(line)
+    return lines
+
+
 def evidence_summary(idata: az.InferenceData) -> dict:
     """Log evidence (nats) per chain, pooled over chains (log of the mean evidence) and its
     standard error: the sd over chains / sqrt(chains); with one chain the kernel's own
