@@ -15,8 +15,8 @@ line per setting:
 * ``sticks``, ``longest_stick_ms``, ``near_stick_pct`` (within 20 ms of a stick) and, per
   model, ``*_rms_near_over_elsewhere``: its RMS residual near the sticks over elsewhere, and
   ``*_nrmse_near_over_elsewhere`` the same of the residual relative to the measured output's
-  RMS there (``measured_rms_near_over_elsewhere``): Figure 7's claim that the linear model
-  fails where the device sticks reads > 1;
+  RMS there (``study.sticking``): Figure 7's claim that the linear model fails where the
+  device sticks reads > 1;
 * ``tanh_sd``: their posterior sds by Laplace (Gauss-Newton Hessian), ``tanh_z``: (estimate -
   truth) / sd, the truth being the rig's Table 5 values; ``tanh_z_adj`` the same with the sds
   adjusted for correlated residuals (``inference.correlated_residuals``, flat priors);
@@ -56,6 +56,7 @@ from harvester.data import daq
 from harvester.inference.correlated_residuals import adjustment_matrix, sandwich, lag_window
 from harvester.data.signals import filter_recording
 from harvester.inference.recording_fit import FitWindow, recording_problem
+from harvester.study.sticking import stick_misfit
 from harvester.synthetic import rig
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -133,32 +134,16 @@ def laplace_log_evidence(f: dict, priors: dict) -> float:
     return log_l + log_p + 0.5 * d * math.log(2.0 * math.pi) - 0.5 * log_det
 
 
-def stick_statistics(stuck: np.ndarray, fits: dict, fs: float = 256.0,
-                     near_s: float = 0.02) -> dict:
-    """Figure 7's question: the rig's sticks over the fitted samples (count, longest) and
-    each model's RMS residual within ``near_s`` of a stick over its RMS elsewhere."""
-    edges = np.diff(np.r_[0, stuck.astype(int), 0])
-    starts, ends = np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0]
-    pad = int(round(near_s * fs))
-    near = np.zeros(stuck.size, dtype=bool)
-    for a, b in zip(starts, ends):
-        near[max(a - pad, 0):b + pad] = True
-    out = {"sticks": int(starts.size),
-           "longest_stick_ms": round(1e3 * float((ends - starts).max(initial=0)) / fs, 1),
-           "near_stick_pct": round(100.0 * float(near.mean()), 2)}
-    if not (near.any() and (~near).any()):
-        return out
+def stick_statistics(stuck: np.ndarray, speed: np.ndarray, fits: dict,
+                     fs: float = 256.0) -> dict:
+    """Figure 7's question (``study.sticking``): the rig's sticks over the fitted samples and
+    each model's misfit near them over elsewhere, absolute and relative to the record."""
     y = next(iter(fits.values()))["problem"].observed
-
-    def rms(x, mask):
-        return float(np.sqrt(np.mean(x[mask] ** 2)))
-
-    out["measured_rms_near_over_elsewhere"] = round(rms(y, near) / rms(y, ~near), 3)
+    out = {}
     for model, f in fits.items():
-        r = f["residual"]
-        out[f"{model}_rms_near_over_elsewhere"] = round(rms(r, near) / rms(r, ~near), 3)
-        out[f"{model}_nrmse_near_over_elsewhere"] = round(
-            rms(r, near) / rms(y, near) / (rms(r, ~near) / rms(y, ~near)), 3)
+        m = stick_misfit(f["residual"], y, stuck, speed, fs).to_dict()
+        out.update({k: v for k, v in m.items() if "over" not in k})
+        out.update({f"{model}_{k}": v for k, v in m.items() if "over" in k})
     return out
 
 
@@ -190,7 +175,8 @@ def analyse(cfg: dict, rc: dict, args, unseen: bool) -> dict:
            "log_bf_laplace": round(laplace_log_evidence(t, priors)
                                    - laplace_log_evidence(fits["linear"], priors), 1),
            "n_log_sigma_ratio": round(t["n"] * math.log(fits["linear"]["sigma"] / t["sigma"]), 1),
-           **stick_statistics(sim.truth["stuck"][lead:lead + n_fit], fits)}
+           **stick_statistics(sim.truth["stuck"][lead:lead + n_fit],
+                              sim.truth["v"][lead:lead + n_fit], fits)}
     if unseen:
         simv, val = filtered_record(rc, "validation", pre)
         rng = np.random.default_rng(11)

@@ -1,13 +1,15 @@
 """Rules fig07/fig09/fig10: model mean against measured response with 3-sigma bounds (the
 ensemble of parameter samples and the full predictive, each with its share outside), where
 the virtual rig stuck shaded from its truth (the record regenerated from the config), and
-for Figure 7 a section around the rig's longest stick."""
+for Figure 7 a section around the rig's longest stick and where the model misses: near the
+sticks or at speed (``study.sticking``)."""
 
 import numpy as np
 
 from harvester.inference.predictive import load_band
 from harvester.plots.predictive import response_figure
 from harvester.runlog import rule_log
+from harvester.study.sticking import stick_misfit
 from harvester.synthetic import rig
 
 with rule_log(snakemake) as log:  # noqa: F821
@@ -30,5 +32,13 @@ with rule_log(snakemake) as log:  # noqa: F821
             lo = min(max(mid - half, band.time[0]), band.time[-1] - 2 * half)
             zoom = (lo, lo + 2 * half)
     log.info("rig stuck at %.2f %% of the shown samples; zoom %s", 100 * stuck.mean(), zoom)
+    misfit = None
+    if sm.params.zoom_s:  # Figure 7: where the model misses, near the sticks or at speed
+        speed = sim.truth["v"][start:start + band.time.size]
+        fs = 1.0 / float(band.time[1] - band.time[0])
+        misfit = stick_misfit(measured - band.mean, measured, stuck, speed, fs)
+        log.info("misfit near the rig's sticks over elsewhere: %s; RMS per speed band "
+                 "(mm/s: share, RMS) %s", misfit.to_dict(),
+                 [(lo, hi, round(sh, 3), round(r, 4)) for lo, hi, sh, r in misfit.by_speed])
     response_figure(band, measured, sm.output[0], sm.params.title, window=window, stuck=stuck,
-                    zoom=zoom)
+                    zoom=zoom, misfit=misfit)

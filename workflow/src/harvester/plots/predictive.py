@@ -14,6 +14,7 @@ from harvester.plots.posterior import SIMULATED_NOTE  # noqa: E402
 from harvester.plots.style import (BOUNDS, HIGHLIGHT, LEGEND_SIZE, MEASURED, MODEL,  # noqa: E402
                                    TITLE_SIZE, save_figure)
 from harvester.inference.predictive import PredictiveBand  # noqa: E402
+from harvester.study.sticking import StickMisfit  # noqa: E402
 
 
 def _spans(t: np.ndarray, mask: np.ndarray) -> list[tuple[float, float]]:
@@ -52,20 +53,21 @@ def response_figure(band: PredictiveBand, measured: np.ndarray, path: str | Path
                     ylabel: str = "relative acceleration $\\ddot z$ (m/s$^2$)",
                     measured_label: str = "measured (virtual rig)",
                     stuck: np.ndarray | None = None,
-                    zoom: tuple[float, float] | None = None) -> None:
+                    zoom: tuple[float, float] | None = None,
+                    misfit: StickMisfit | None = None) -> None:
     """Measured output in grey, model mean in black, +-k sd bounds shaded (two kinds: the
     paper's, the ensemble of parameter samples, and the full predictive with the likelihood's
     sigma), each labelled with the share of the shown measured samples outside it; ``note``
     is the subtitle, ``ylabel`` the output with its unit. ``stuck`` (bool per sample of the
-    band): where the rig stuck, shaded. ``zoom`` (s): a second panel on that section."""
+    band): where the rig stuck, shaded. ``zoom`` (s): a second panel on that section.
+    ``misfit``: a last panel, the model's RMS misfit per band of screw speed and near the
+    sticks against elsewhere (``study.sticking``)."""
     t = band.time
     sel = slice(None) if window is None else (t >= window[0]) & (t <= window[1])
     width = 11 if window is None or (window[1] - window[0]) > 20 else 9
-    if zoom is None:
-        fig, ax = plt.subplots(figsize=(width, 4))
-        axes = [ax]
-    else:
-        fig, axes = plt.subplots(2, 1, figsize=(width, 7))
+    rows = 1 + (zoom is not None) + (misfit is not None)
+    fig, axes = plt.subplots(rows, 1, figsize=(width, 4 + 3 * (rows - 1)), squeeze=False)
+    axes = list(axes[:, 0])
     lw = 0.6 if window is None else 1.0
     _draw(axes[0], band, measured, sel, k, lw, measured_label, stuck, True)
     axes[0].set_title(f"{title}\n{note}", fontsize=TITLE_SIZE)
@@ -75,7 +77,29 @@ def response_figure(band: PredictiveBand, measured: np.ndarray, path: str | Path
         _draw(axes[1], band, measured, part, k, 1.2, measured_label, stuck, False)
         axes[1].set_title(f"section {zoom[0]:.2f}-{zoom[1]:.2f} s", fontsize=TITLE_SIZE)
         axes[0].axvspan(zoom[0], zoom[1], color="0.85", alpha=0.5, lw=0, zorder=0)
-    for ax in axes:
+    for ax in axes[:rows - (misfit is not None)]:
         ax.set_xlabel("time (s)")
         ax.set_ylabel(ylabel)
+    if misfit is not None:
+        _misfit_panel(axes[-1], misfit, ylabel[ylabel.rfind("("):] if "(" in ylabel else "")
     save_figure(fig, path)
+
+
+def _misfit_panel(ax, m: StickMisfit, unit: str) -> None:
+    """Bars: the RMS of measured minus model mean per band of the rig's screw speed (truth),
+    each labelled with its share of the samples; the title gives the misfit near the sticks
+    over elsewhere, absolute and relative to the record there."""
+    labels = [f"{lo:g}-{hi:g}" if np.isfinite(hi) else f"> {lo:g}" for lo, hi, _, _ in
+              m.by_speed]
+    rms = [r for *_, r in m.by_speed]
+    bars = ax.bar(labels, rms, color=MODEL, alpha=0.6)
+    for bar, (_, _, share, _) in zip(bars, m.by_speed):
+        ax.annotate(f"{100 * share:.0f} %", (bar.get_x() + bar.get_width() / 2,
+                                             bar.get_height()), ha="center", va="bottom",
+                    fontsize=LEGEND_SIZE)
+    ax.set_xlabel("rig's screw speed |z'| (mm/s, truth); labels: share of the samples")
+    ax.set_ylabel(f"RMS of measured - mean {unit}".strip())
+    ax.set_title("where the model misses (the rig's truth): RMS misfit per band of screw speed\n"
+                 f"within 20 ms of its {m.sticks} sticks ({100 * m.near_share:.1f} % of the "
+                 f"samples): {m.absolute_ratio:.2f} x the misfit elsewhere, "
+                 f"{m.relative_ratio:.2f} x relative to the record there", fontsize=TITLE_SIZE)
