@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from harvester.inference.correlated_residuals import (Adjustment, adjustment_matrix, sandwich,
-                                                      lag_window)
+from harvester.inference.correlated_residuals import (Adjustment, adjustment_matrix, lag_window,
+                                                      prior_precision, sandwich)
 
 N = 2000
 FS, CUTOFF = 256.0, 20.0
@@ -79,8 +79,19 @@ def test_the_prior_part_of_the_posterior_is_kept():
     """A posterior twice as precise as the likelihood (prior = likelihood) with V = 4 H: the
     adjusted precision is the prior's H plus H V^-1 H = H / 4, covariance 0.8 H^-1."""
     h = np.diag([4.0, 9.0])
-    mat = adjustment_matrix(np.linalg.inv(2.0 * h), h, 4.0 * h)
+    mat = adjustment_matrix(np.linalg.inv(2.0 * h), h, 4.0 * h, prior_precision=h)
     assert mat @ np.linalg.inv(2.0 * h) @ mat.T == pytest.approx(np.linalg.inv(1.25 * h))
+
+
+def test_prior_curvature_of_each_family():
+    """Normal: 1 / sd^2; log-normal at its median: (1 + 0 ...) from ln x's; log-uniform: its
+    curvature is negative, so none; a parameter without a prior: none."""
+    from harvester.model.priors import PriorSpec
+    priors = {"a": PriorSpec("a", 100.0, 5.0, ""), "b": PriorSpec.log_normal("b", 2.0, 0.5, ""),
+              "c": PriorSpec.log_uniform("c", 1.0, 100.0, "")}
+    prec = np.diag(prior_precision(priors, ["a", "b", "c", "d"], np.array([90.0, 2.0, 10.0, 1.0])))
+    # log-normal: -(d^2/dx^2)[-(ln x - ln 2)^2 / (2 s^2) - ln x] at x = 2 is (1/s^2 - 1) / x^2
+    assert prec == pytest.approx([1 / 25.0, (1 / 0.25 - 1.0) / 4.0, 0.0, 0.0], rel=1e-4)
 
 
 def test_adjustment_round_trips_and_scales_about_its_center():
@@ -89,3 +100,61 @@ def test_adjustment_round_trips_and_scales_about_its_center():
     assert again == adj
     assert again.apply(np.array([[2.0, 2.0], [1.0, 3.0]])) == pytest.approx(
         np.array([[3.0, 2.0], [1.0, 5.0]]))
+
+
+@pytest.fixture(scope="module")
+def tanh_problem():
+    """The study's tanh problem on the bundled training record (as tests/test_identify_study)."""
+    from pathlib import Path
+
+    import yaml
+
+    from harvester.data.daq import read_raw_record, to_accelerations
+    from harvester.data.signals import filter_recording
+    from harvester.inference.problems import make_problem
+    root = Path(__file__).resolve().parents[1]
+    cfg = yaml.safe_load((root / "config/config.yaml").read_text())
+    raw, meta = read_raw_record(root / "data/raw/training.csv", root / "data/raw/training.json")
+    pre, rig = cfg["preprocess"], cfg["rig"]
+    rec = filter_recording(to_accelerations(raw, meta), pre["lowpass_hz"], pre["filter_order"])
+    start = pre["training_lead_in"]
+    return make_problem(rec, "tanh", {"M": rig["M"], "m": rig["m"], "k": rig["k"]},
+                        window=(start, start + pre["training_samples"]),
+                        output_filter=(pre["lowpass_hz"], pre["filter_order"]))
+
+
+def _draws(problem, rng, fixed=None):
+    """400 draws of eq. (10)'s Laplace posterior at the study's posterior mean (its curvature
+    from the output's Jacobian), sigma at its mean; ``fixed``: a parameter held constant."""
+    from harvester.inference.correlated_residuals import output_jacobian
+    center = np.array([105.4, 12.16, 81.7])
+    r, jac = output_jacobian(problem, center, np.array([0.1, 0.005, 0.1]), 0.0953)
+    cov = np.linalg.inv(jac.T @ jac / np.mean(r ** 2))
+    theta = rng.multivariate_normal(center, cov, 400)
+    if fixed is not None:
+        theta[:, fixed] = center[fixed]
+    return np.column_stack([theta, np.full(400, 0.0953)])
+
+
+def test_the_study_record_widens_and_what_cannot_be_adjusted_is_said(tanh_problem, caplog,
+                                                                     monkeypatch):
+    """On the low-passed record the intervals widen about 2.3 x (the study's posterior:
+    2.31-2.36 x); draws that do not vary, and a curvature that is singular, give no
+    adjustment and a warning instead of an error after a long TMCMC."""
+    import harvester.inference.correlated_residuals as cr
+    rng = np.random.default_rng(4)
+    adj = cr.correlation_adjustment(tanh_problem, _draws(tanh_problem, rng))
+    assert adj is not None and adj.names == ("c_m", "F_c", "beta")
+    assert all(1.8 < f < 3.0 for f in adj.inflation), adj.inflation
+    assert cr.correlation_adjustment(tanh_problem, _draws(tanh_problem, rng, 1)) is None
+    assert "F_c do not vary" in caplog.text
+
+    def flat(problem, center, steps, sigma):
+        r, jac = output_jacobian(problem, center, steps, sigma)
+        jac[:, 1] = 0.0
+        return r, jac
+    output_jacobian = cr.output_jacobian
+    draws = _draws(tanh_problem, rng)
+    monkeypatch.setattr(cr, "output_jacobian", flat)
+    assert cr.correlation_adjustment(tanh_problem, draws) is None
+    assert "singular" in caplog.text

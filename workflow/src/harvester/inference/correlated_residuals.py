@@ -17,7 +17,8 @@ rescales its draws about their mean, the curvature adjustment of Ribatet, Cooley
   integrated autocorrelation time): a residual that rings (the Silverbox's, at 200 Hz) has an
   autocorrelation that Sokal's sum reads as short;
 * the estimate's covariance is then the sandwich H^-1 V H^-1, and the adjusted posterior
-  precision is the prior's part of the posterior precision plus H V^-1 H.
+  precision is the priors' curvature at the posterior mean plus H V^-1 H (whatever power
+  ``Problem.temper`` the sampled likelihood had: the sandwich is that of the estimate).
 
 With white residuals V = H and nothing changes. Only the physical parameters are adjusted;
 sigma's draws are left as they are.
@@ -28,6 +29,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING
 
@@ -35,6 +37,7 @@ import numpy as np
 
 if TYPE_CHECKING:  # the tables read an Adjustment without the simulator's import
     from harvester.inference.likelihood import Problem
+    from harvester.model.priors import PriorSpec
 
 log = logging.getLogger("harvester.inference.correlated_residuals")
 
@@ -128,17 +131,32 @@ def sandwich(jac: np.ndarray, r: np.ndarray, max_lag: int) -> tuple[np.ndarray, 
 
 
 def adjustment_matrix(post_cov: np.ndarray, h: np.ndarray, v: np.ndarray,
-                      temper: float = 1.0) -> np.ndarray:
-    """C with C post_cov C^T = the adjusted posterior covariance: the posterior precision less
-    the working likelihood's curvature (temper x H: the prior's part, kept; clipped at zero)
-    plus H V^-1 H (Ribatet et al. 2012's curvature adjustment)."""
-    prec = np.linalg.inv(post_cov)
-    prior_part = prec - temper * h
-    w, q = np.linalg.eigh(0.5 * (prior_part + prior_part.T))
-    prior_part = (q * np.clip(w, 0.0, None)) @ q.T
-    adj_prec = prior_part + h @ np.linalg.solve(v, h)
+                      prior_precision: np.ndarray | None = None) -> np.ndarray:
+    """C with C post_cov C^T = the adjusted posterior covariance, (prior precision +
+    H V^-1 H)^-1: the likelihood's curvature replaced by the inverse of the sandwich (Ribatet
+    et al. 2012's curvature adjustment), the prior's kept (zero where not given: the data
+    dominate)."""
+    adj_prec = h @ np.linalg.solve(v, h)
+    if prior_precision is not None:
+        adj_prec = adj_prec + prior_precision
     adj_cov = np.linalg.inv(0.5 * (adj_prec + adj_prec.T))
     return np.linalg.cholesky(adj_cov) @ np.linalg.inv(np.linalg.cholesky(post_cov))
+
+
+def prior_precision(priors: Mapping[str, PriorSpec], names: Sequence[str],
+                    x: np.ndarray) -> np.ndarray:
+    """Diagonal precision of independent priors at x: minus the second derivative of each
+    log density (central differences), at least zero (a log-uniform prior's is negative)."""
+    out = np.zeros(len(names))
+    for j, (name, value) in enumerate(zip(names, x)):
+        spec = priors.get(name)
+        if spec is None:
+            continue
+        step = 1e-3 * max(abs(float(value)), float(spec.sd) * 1e-3, 1e-300)
+        f = [float(spec.logpdf(value + k * step)) for k in (-1, 0, 1)]
+        if all(np.isfinite(f)):
+            out[j] = max(-(f[0] - 2.0 * f[1] + f[2]) / step ** 2, 0.0)
+    return np.diag(out)
 
 
 def output_jacobian(problem: Problem, center: np.ndarray, steps: np.ndarray,
@@ -153,25 +171,39 @@ def output_jacobian(problem: Problem, center: np.ndarray, steps: np.ndarray,
     return r[0], ((r[1:p + 1] - r[p + 1:]) / (2.0 * steps[:, None])).T
 
 
-def correlation_adjustment(problem: Problem, theta: np.ndarray) -> Adjustment | None:
+def correlation_adjustment(problem: Problem, theta: np.ndarray,
+                           priors: Mapping[str, PriorSpec] | None = None) -> Adjustment | None:
     """The adjustment of posterior draws ``theta`` (rows: the problem's parameters, sigma last)
-    for the residuals' correlation; None (logged) where the Jacobian cannot be formed (a failed
-    simulation) or the posterior has a single draw."""
+    for the residuals' correlation, keeping the curvature of ``priors`` (by name) at the
+    posterior mean; None (logged) where it cannot be formed: too few draws, a
+    parameter whose draws do not vary (a collapsed population), a failed simulation near the
+    posterior mean, or a singular curvature (a parameter the output does not depend on)."""
     names = problem.parameter_names[:-1]
     x = np.asarray(theta, dtype=float)[:, :len(names)]
     if x.shape[0] < 2 * len(names) + 2 or not names:
         return None
     center, cov = x.mean(axis=0), np.atleast_2d(np.cov(x, rowvar=False))
     sd = np.sqrt(np.diag(cov))
-    sigma = float(np.mean(np.asarray(theta)[:, -1]))
-    r, jac = output_jacobian(problem, center, STEP_SDS * np.where(sd > 0, sd, 1e-12), sigma)
-    if not (np.all(np.isfinite(r)) and np.all(np.isfinite(jac))):
-        log.warning("%s: no interval adjustment for correlated residuals (a simulation near "
-                    "the posterior mean failed)", problem.structure.name)
+    why = None
+    still = ~(sd > 1e-9 * np.maximum(np.abs(center), 1e-300))
+    if still.any():
+        why = f"the draws of {', '.join(n for n, s in zip(names, still) if s)} do not vary"
+    else:
+        sigma = float(np.mean(np.asarray(theta)[:, -1]))
+        r, jac = output_jacobian(problem, center, STEP_SDS * sd, sigma)
+        if not (np.all(np.isfinite(r)) and np.all(np.isfinite(jac))):
+            why = "a simulation near the posterior mean failed"
+    if why is None:
+        tau, lag = lag_window(r)
+        try:
+            mat = adjustment_matrix(cov, *sandwich(jac, r, lag),
+                                    prior_precision(priors or {}, names, center))
+        except np.linalg.LinAlgError:
+            why = "the curvature is singular (the output does not depend on every parameter)"
+    if why is not None:
+        log.warning("%s: no interval adjustment for correlated residuals (%s)",
+                    problem.structure.name, why)
         return None
-    tau, lag = lag_window(r)
-    h, v = sandwich(jac, r, lag)
-    mat = adjustment_matrix(cov, h, v, problem.temper)
     inflation = np.sqrt(np.diag(mat @ cov @ mat.T)) / sd
     log.info("%s: residuals' integrated autocorrelation time %.2g samples (lags to %d); "
              "intervals for correlated residuals %s x eq. (10)'s", problem.structure.name, tau,

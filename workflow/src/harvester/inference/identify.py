@@ -79,7 +79,8 @@ def identify(problem: Problem, priors: Mapping[str, PriorSpec],
     idata.posterior.attrs["free_base"] = ",".join(problem.structure.free_base)
     idata.posterior.attrs["input_kind"] = problem.input_kind
     idata.posterior.attrs["output_kind"] = problem.output_kind
-    adjustment = correlated_residuals.correlation_adjustment(problem, posterior_theta(idata))
+    adjustment = correlated_residuals.correlation_adjustment(
+        problem, posterior_theta(idata), priors_for(problem, priors))
     if adjustment is not None:
         idata.posterior.attrs[correlated_residuals.ATTRIBUTE] = adjustment.to_json()
     return idata
