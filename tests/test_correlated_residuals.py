@@ -158,3 +158,35 @@ def test_the_study_record_widens_and_what_cannot_be_adjusted_is_said(tanh_proble
     monkeypatch.setattr(cr, "output_jacobian", flat)
     assert cr.correlation_adjustment(tanh_problem, draws) is None
     assert "singular" in caplog.text
+
+
+def test_the_bread_is_the_sum_of_squares_curvature():
+    """For residuals linear in theta, SSE'' = 2 X^T X exactly; for y - a exp(b t) it is
+    Gauss-Newton's 2 J^T J plus the residuals' own curvature (checked against the closed
+    form)."""
+    from harvester.inference.correlated_residuals import sse_curvature
+    rng = np.random.default_rng(5)
+    x = rng.standard_normal((200, 2))
+    y = x @ np.array([1.0, -2.0]) + rng.standard_normal(200)
+
+    class Linear:
+        def residuals(self, theta):
+            return y[None, :] - theta[:, :2] @ x.T
+
+    hess = sse_curvature(Linear(), np.array([1.0, -2.0]), np.array([0.1, 0.1]), 1.0)
+    assert hess == pytest.approx(2.0 * x.T @ x, rel=1e-8)
+    t = np.linspace(0.0, 1.0, 100)
+    obs = 2.0 * np.exp(0.5 * t) + 0.3 * np.sin(9.0 * t)  # a misfit the model cannot take
+
+    class Exponential:
+        def residuals(self, theta):
+            return obs[None, :] - theta[:, :1] * np.exp(theta[:, 1:2] * t[None, :])
+
+    a, b = 2.0, 0.5
+    e = np.exp(b * t)
+    r = obs - a * e
+    ja, jb = -e, -a * t * e  # d r / d(a, b)
+    exact = 2.0 * np.array([[ja @ ja, ja @ jb], [ja @ jb, jb @ jb]]) + 2.0 * np.array(
+        [[0.0, r @ (-t * e)], [r @ (-t * e), r @ (-a * t * t * e)]])
+    hess = sse_curvature(Exponential(), np.array([a, b]), np.array([1e-3, 1e-3]), 1.0)
+    assert hess == pytest.approx(exact, rel=1e-4)

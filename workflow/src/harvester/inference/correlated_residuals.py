@@ -9,18 +9,20 @@ The adjustment keeps eq. (10)'s posterior (its mean, the evidence, the tables' m
 rescales its draws about their mean, the curvature adjustment of Ribatet, Cooley and Davison
 (2012, Statistica Sinica 22, 813-845) for a misspecified likelihood:
 
-* the working likelihood's curvature is H = J^T J / sigma^2 (J the model output's Jacobian on
-  the fitted samples at the posterior mean, Gauss-Newton);
+* the working likelihood's curvature at the posterior mean is A = SSE'' / (2 sigma^2), by
+  central differences (Gauss-Newton's J^T J / sigma^2, J the model output's Jacobian on the
+  fitted samples, leaves out the residuals' own curvature, which a misspecified model keeps
+  large);
 * the variance of its score is V = J^T R J / sigma^4, R the residuals' covariance: a Toeplitz
   matrix of their autocovariance, tapered by a Bartlett window out to a lag of at least 4
   n^(1/3) (Andrews 1991's rate for that window) and at least Sokal's automatic window (5 x the
   integrated autocorrelation time): a residual that rings (the Silverbox's, at 200 Hz) has an
   autocorrelation that Sokal's sum reads as short;
-* the estimate's covariance is then the sandwich H^-1 V H^-1, and the adjusted posterior
-  precision is the priors' curvature at the posterior mean plus H V^-1 H (whatever power
+* the estimate's covariance is then the sandwich A^-1 V A^-1, and the adjusted posterior
+  precision is the priors' curvature at the posterior mean plus A V^-1 A (whatever power
   ``Problem.temper`` the sampled likelihood had: the sandwich is that of the estimate).
 
-With white residuals V = H and nothing changes. Only the physical parameters are adjusted;
+With white residuals and a model that fits, V = A and nothing changes. Only the physical parameters are adjusted;
 sigma's draws are left as they are.
 """
 
@@ -171,6 +173,46 @@ def output_jacobian(problem: Problem, center: np.ndarray, steps: np.ndarray,
     return r[0], ((r[1:p + 1] - r[p + 1:]) / (2.0 * steps[:, None])).T
 
 
+def sse_curvature(problem: Problem, center: np.ndarray, steps: np.ndarray,
+                  sigma: float) -> np.ndarray:
+    """Hessian (p, p) of the sum of squared residuals at ``center`` by central differences
+    of step ``steps`` (one batched simulation of 2 p (p + 1) + 1 rows): the sandwich's bread. Unlike
+    Gauss-Newton's 2 J^T J it keeps the residuals' own curvature, which a misspecified model
+    (a linear model of a friction device) leaves large."""
+    p = center.size
+    offsets = [np.zeros(p)]
+    for i in range(p):
+        for j in range(i, p):
+            for si, sj in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
+                d = np.zeros(p)
+                d[i] += si * steps[i]
+                d[j] += sj * steps[j]
+                offsets.append(d)
+    rows = center + np.array(offsets)
+    r = problem.residuals(np.column_stack([rows, np.full(len(rows), sigma)]))
+    sse = np.sum(r * r, axis=1)  # the residuals the Jacobian and the meat are taken of
+    hess, k = np.zeros((p, p)), 1
+    for i in range(p):
+        for j in range(i, p):
+            pp, pm, mp, mm = sse[k:k + 4]
+            hess[i, j] = hess[j, i] = (pp - pm - mp + mm) / (4.0 * steps[i] * steps[j])
+            k += 4
+    return hess
+
+
+def _bread(problem: Problem, center: np.ndarray, sd: np.ndarray, sigma: float,
+           gauss_newton: np.ndarray, s2: float) -> np.ndarray:
+    """The likelihood's curvature at the posterior mean, SSE'' / (2 s^2) (:func:`sse_curvature`,
+    steps of half a posterior sd); Gauss-Newton's where that is not positive definite or not
+    finite (a failed simulation in the stencil)."""
+    bread = sse_curvature(problem, center, 0.5 * sd, sigma) / (2.0 * s2)
+    if np.all(np.isfinite(bread)) and np.all(np.linalg.eigvalsh(bread) > 0):
+        return bread
+    log.info("%s: the curvature by differences is not positive definite; Gauss-Newton's is "
+             "used", problem.structure.name)
+    return gauss_newton
+
+
 def correlation_adjustment(problem: Problem, theta: np.ndarray,
                            priors: Mapping[str, PriorSpec] | None = None) -> Adjustment | None:
     """The adjustment of posterior draws ``theta`` (rows: the problem's parameters, sigma last)
@@ -195,9 +237,10 @@ def correlation_adjustment(problem: Problem, theta: np.ndarray,
             why = "a simulation near the posterior mean failed"
     if why is None:
         tau, lag = lag_window(r)
+        h, v = sandwich(jac, r, lag)
+        bread = _bread(problem, center, sd, sigma, h, float(np.mean(np.square(r))))
         try:
-            mat = adjustment_matrix(cov, *sandwich(jac, r, lag),
-                                    prior_precision(priors or {}, names, center))
+            mat = adjustment_matrix(cov, bread, v, prior_precision(priors or {}, names, center))
         except np.linalg.LinAlgError:
             why = "the curvature is singular (the output does not depend on every parameter)"
     if why is not None:
