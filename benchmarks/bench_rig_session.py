@@ -53,7 +53,8 @@ import yaml
 from scipy import optimize
 
 from harvester.data import daq
-from harvester.inference.correlated_residuals import adjustment_matrix, sandwich, lag_window
+from harvester.inference.correlated_residuals import (adjustment_matrix, lag_window, sandwich,
+                                                      sse_curvature)
 from harvester.data.signals import filter_recording
 from harvester.inference.recording_fit import FitWindow, recording_problem
 from harvester.study.sticking import stick_misfit
@@ -114,8 +115,11 @@ def fit(problem, model: str) -> dict:
     jac = np.array(jac).T
     hess = jac.T @ jac / sigma ** 2
     cov = np.linalg.inv(hess)
-    _, lag = lag_window(problem.observed - y0)
-    mat = adjustment_matrix(cov, *sandwich(jac, problem.observed - y0, lag))
+    r = problem.observed - y0
+    _, lag = lag_window(r)
+    _, meat = sandwich(jac, r, lag)
+    bread = sse_curvature(problem, x, 0.5 * np.sqrt(np.diag(cov)), sigma) / (2.0 * sigma ** 2)
+    mat = adjustment_matrix(cov, bread, meat)
     return {"x": x, "sigma": sigma, "cov": cov, "hess": hess, "n": n,
             "residual": problem.observed - y0,
             "cov_adj": mat @ cov @ mat.T,
