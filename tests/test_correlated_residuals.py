@@ -190,3 +190,16 @@ def test_the_bread_is_the_sum_of_squares_curvature():
         [[0.0, r @ (-t * e)], [r @ (-t * e), r @ (-a * t * t * e)]])
     hess = sse_curvature(Exponential(), np.array([a, b]), np.array([1e-3, 1e-3]), 1.0)
     assert hess == pytest.approx(exact, rel=1e-4)
+
+
+def test_a_posterior_cut_by_its_bound_is_not_rescaled():
+    """EMPS's c_quad (mean 32, sd 31, bound 0) is cut; c_m (407 +- 8.5, bound 0) and an
+    unbounded offset are not."""
+    from harvester.inference.correlated_residuals import cut_by_bound
+    from harvester.model.priors import PriorSpec
+    priors = {"c_m": PriorSpec("c_m", 200.0, 100.0, ""), "c_quad": PriorSpec("c_quad", 0.0, 50.0,
+                                                                             ""),
+              "F_offset": PriorSpec("F_offset", 0.0, 10.0, "", -np.inf)}
+    names = ["c_m", "c_quad", "F_offset"]
+    assert cut_by_bound(priors, names, np.array([407.0, 32.3, -3.2]),
+                        np.array([8.5, 30.7, 0.75])) == ["c_quad"]
