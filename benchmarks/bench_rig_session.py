@@ -53,8 +53,8 @@ import yaml
 from scipy import optimize
 
 from harvester.data import daq
-from harvester.inference.correlated_residuals import (adjustment_matrix, lag_window, sandwich,
-                                                      sse_curvature)
+from harvester.inference.correlated_residuals import (adjustment_matrix, lag_window,
+                                                      likelihood_curvature, sandwich)
 from harvester.data.signals import filter_recording
 from harvester.inference.recording_fit import FitWindow, recording_problem
 from harvester.study.sticking import stick_misfit
@@ -117,8 +117,9 @@ def fit(problem, model: str) -> dict:
     cov = np.linalg.inv(hess)
     r = problem.observed - y0
     _, lag = lag_window(r)
-    _, meat = sandwich(jac, r, lag)
-    bread = sse_curvature(problem, x, 0.5 * np.sqrt(np.diag(cov)), sigma) / (2.0 * sigma ** 2)
+    gauss_newton, meat = sandwich(jac, r, lag)
+    bread = likelihood_curvature(problem, x, np.sqrt(np.diag(cov)), sigma, gauss_newton,
+                                 float(np.mean(r * r)))
     mat = adjustment_matrix(cov, bread, meat)
     return {"x": x, "sigma": sigma, "cov": cov, "hess": hess, "n": n,
             "residual": problem.observed - y0,

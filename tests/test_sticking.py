@@ -34,3 +34,15 @@ def test_a_misfit_made_near_the_sticks_reads_above_one_and_by_speed():
     assert shares[(0.0, 2.0)] == pytest.approx(0.015) and shares[(30.0, 60.0)] == pytest.approx(
         0.985)
     assert m.to_dict()["nrmse_near_over_elsewhere"] == 6.0
+
+
+def test_the_zoom_is_centred_on_the_longest_stick_and_kept_inside():
+    from harvester.study.sticking import longest_stick_window
+    t = np.arange(1000) / FS
+    stuck = np.zeros(1000, dtype=bool)
+    stuck[100:103] = stuck[500:520] = True  # the longest: 5.00-5.19 s
+    assert longest_stick_window(stuck, t, 1.0) == pytest.approx((4.595, 5.595))
+    stuck[:] = False
+    stuck[2:30] = True  # near the start: the section starts at the record's start
+    assert longest_stick_window(stuck, t, 1.0) == pytest.approx((0.0, 1.0))
+    assert longest_stick_window(np.zeros(1000, dtype=bool), t, 1.0) is None

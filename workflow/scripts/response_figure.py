@@ -9,7 +9,7 @@ import numpy as np
 from harvester.inference.predictive import load_band
 from harvester.plots.predictive import response_figure
 from harvester.runlog import rule_log
-from harvester.study.sticking import stick_misfit
+from harvester.study.sticking import longest_stick_window, stick_misfit
 from harvester.synthetic import rig
 
 with rule_log(snakemake) as log:  # noqa: F821
@@ -21,16 +21,8 @@ with rule_log(snakemake) as log:  # noqa: F821
     stuck = sim.truth["stuck"][start:start + band.time.size]
     if stuck.size != band.time.size or not np.allclose(sim.time[start], band.time[0]):
         raise ValueError(f"{sm.params.record}: the rig's record does not line up with the band")
-    zoom = None
-    if sm.params.zoom_s:
-        edge = np.diff(np.r_[0, stuck.astype(int), 0])
-        runs = list(zip(np.flatnonzero(edge == 1), np.flatnonzero(edge == -1)))
-        if runs:
-            a, b = max(runs, key=lambda r: r[1] - r[0])
-            mid = 0.5 * (band.time[a] + band.time[b - 1])
-            half = 0.5 * float(sm.params.zoom_s)
-            lo = min(max(mid - half, band.time[0]), band.time[-1] - 2 * half)
-            zoom = (lo, lo + 2 * half)
+    zoom = longest_stick_window(stuck, band.time, sm.params.zoom_s) if sm.params.zoom_s \
+        else None
     log.info("rig stuck at %.2f %% of the shown samples; zoom %s", 100 * stuck.mean(), zoom)
     misfit = None
     if sm.params.zoom_s:  # Figure 7: where the model misses, near the sticks or at speed

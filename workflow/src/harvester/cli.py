@@ -427,7 +427,7 @@ def compare_command(args: argparse.Namespace) -> int:
 
     from harvester.data.fileio import atomic_directory, check_output_dir, write_json
     from harvester.inference.compare import evidence_table, verdict
-    from harvester.inference.recording_fit import fit_recording, interval_lines, parameter_table
+    from harvester.inference.recording_fit import fit_recording
     check_output_dir(args.out, inputs=(args.recording,))
     if len(set(args.models)) != len(args.models):
         raise DataError("<command line>", f"--models repeats a model: {args.models}")

@@ -22,8 +22,8 @@ rescales its draws about their mean, the curvature adjustment of Ribatet, Cooley
   precision is the priors' curvature at the posterior mean plus A V^-1 A (whatever power
   ``Problem.temper`` the sampled likelihood had: the sandwich is that of the estimate).
 
-With white residuals and a model that fits, V = A and nothing changes. Only the physical parameters are adjusted;
-sigma's draws are left as they are.
+With white residuals and a model that fits, V = A and nothing changes. Only the physical
+parameters are adjusted; sigma's draws are left as they are.
 """
 
 from __future__ import annotations
@@ -176,35 +176,30 @@ def output_jacobian(problem: Problem, center: np.ndarray, steps: np.ndarray,
 def sse_curvature(problem: Problem, center: np.ndarray, steps: np.ndarray,
                   sigma: float) -> np.ndarray:
     """Hessian (p, p) of the sum of squared residuals at ``center`` by central differences
-    of step ``steps`` (one batched simulation of 2 p (p + 1) + 1 rows): the sandwich's bread. Unlike
-    Gauss-Newton's 2 J^T J it keeps the residuals' own curvature, which a misspecified model
-    (a linear model of a friction device) leaves large."""
+    of step ``steps`` (one batched simulation of 2 p^2 + 1 rows: the centre, +-h_i, and the
+    four corners of each pair). Unlike Gauss-Newton's 2 J^T J it keeps the residuals' own
+    curvature, which a misspecified model (a linear model of a friction device) leaves large."""
     p = center.size
-    offsets = [np.zeros(p)]
-    for i in range(p):
-        for j in range(i, p):
-            for si, sj in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
-                d = np.zeros(p)
-                d[i] += si * steps[i]
-                d[j] += sj * steps[j]
-                offsets.append(d)
+    eye = np.diag(steps)
+    pairs = [(i, j) for i in range(p) for j in range(i + 1, p)]
+    offsets = [np.zeros(p), *eye, *(-eye)]
+    offsets += [si * eye[i] + sj * eye[j] for i, j in pairs
+                for si, sj in ((1, 1), (1, -1), (-1, 1), (-1, -1))]
     rows = center + np.array(offsets)
     r = problem.residuals(np.column_stack([rows, np.full(len(rows), sigma)]))
     sse = np.sum(r * r, axis=1)  # the residuals the Jacobian and the meat are taken of
-    hess, k = np.zeros((p, p)), 1
-    for i in range(p):
-        for j in range(i, p):
-            pp, pm, mp, mm = sse[k:k + 4]
-            hess[i, j] = hess[j, i] = (pp - pm - mp + mm) / (4.0 * steps[i] * steps[j])
-            k += 4
+    hess = np.diag((sse[1:p + 1] - 2.0 * sse[0] + sse[p + 1:2 * p + 1]) / steps ** 2)
+    for k, (i, j) in enumerate(pairs):
+        pp, pm, mp, mm = sse[2 * p + 1 + 4 * k:2 * p + 5 + 4 * k]
+        hess[i, j] = hess[j, i] = (pp - pm - mp + mm) / (4.0 * steps[i] * steps[j])
     return hess
 
 
-def _bread(problem: Problem, center: np.ndarray, sd: np.ndarray, sigma: float,
-           gauss_newton: np.ndarray, s2: float) -> np.ndarray:
-    """The likelihood's curvature at the posterior mean, SSE'' / (2 s^2) (:func:`sse_curvature`,
-    steps of half a posterior sd); Gauss-Newton's where that is not positive definite or not
-    finite (a failed simulation in the stencil)."""
+def likelihood_curvature(problem: Problem, center: np.ndarray, sd: np.ndarray, sigma: float,
+                         gauss_newton: np.ndarray, s2: float) -> np.ndarray:
+    """The sandwich's bread: the likelihood's curvature at the posterior mean, SSE'' / (2 s^2)
+    (:func:`sse_curvature`, steps of half a posterior sd); Gauss-Newton's where that is not
+    positive definite or not finite (a failed simulation in the stencil)."""
     bread = sse_curvature(problem, center, 0.5 * sd, sigma) / (2.0 * s2)
     if np.all(np.isfinite(bread)) and np.all(np.linalg.eigvalsh(bread) > 0):
         return bread
@@ -260,7 +255,7 @@ def correlation_adjustment(problem: Problem, theta: np.ndarray,
     if why is None:
         tau, lag = lag_window(r)
         h, v = sandwich(jac, r, lag)
-        bread = _bread(problem, center, sd, sigma, h, float(np.mean(np.square(r))))
+        bread = likelihood_curvature(problem, center, sd, sigma, h, float(np.mean(np.square(r))))
         try:
             mat = adjustment_matrix(cov, bread, v, prior_precision(priors or {}, names, center))
         except np.linalg.LinAlgError:

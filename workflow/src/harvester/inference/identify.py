@@ -56,13 +56,15 @@ class TMCMCSettings:
 
 
 def identify(problem: Problem, priors: Mapping[str, PriorSpec],
-             settings: TMCMCSettings, reference: Reference | None = None) -> az.InferenceData:
+             settings: TMCMCSettings, reference: Reference | None = None,
+             adjust: bool = True) -> az.InferenceData:
     """Posterior samples and log evidence of ``problem`` by TMCMC (ArviZ InferenceData).
 
     ``reference``: temper from it instead of the prior (``harvester.inference.tmcmc.Reference``); its
     prior must be the one ``priors`` gives its variable. Without one, ``settings.start`` "map"
-    tempers from :func:`map_start`. The draws' adjustment for correlated residuals
-    (``correlated_residuals``) is stored with them; the tables give both intervals."""
+    tempers from :func:`map_start`. With ``adjust`` the draws' adjustment for correlated
+    residuals (``correlated_residuals``) is stored with them; the tables give both
+    intervals."""
     if reference is None and settings.start == "map":
         reference = map_start(problem, priors, settings.seed)
     model = build_model(problem, priors)
@@ -80,7 +82,7 @@ def identify(problem: Problem, priors: Mapping[str, PriorSpec],
     idata.posterior.attrs["input_kind"] = problem.input_kind
     idata.posterior.attrs["output_kind"] = problem.output_kind
     adjustment = correlated_residuals.correlation_adjustment(
-        problem, posterior_theta(idata), priors_for(problem, priors))
+        problem, posterior_theta(idata), priors_for(problem, priors)) if adjust else None
     if adjustment is not None:
         idata.posterior.attrs[correlated_residuals.ATTRIBUTE] = adjustment.to_json()
     return idata

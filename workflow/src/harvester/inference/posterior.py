@@ -87,9 +87,8 @@ def interval_columns(x: np.ndarray, adjusted: np.ndarray | None) -> dict[str, fl
     95 % interval of the same draws adjusted for correlated residuals (NaN where not)."""
     out = {"mean": x.mean(), "sd": x.std(ddof=1) if x.size > 1 else np.nan,
            "q2.5": np.quantile(x, 0.025), "q97.5": np.quantile(x, 0.975)}
-    a = adjusted if adjusted is not None else np.full(2, np.nan)
-    out.update(zip(ADJUSTED_COLUMNS, (a.std(ddof=1), np.quantile(a, 0.025),
-                                      np.quantile(a, 0.975))))
+    out.update(dict.fromkeys(ADJUSTED_COLUMNS, np.nan) if adjusted is None else zip(
+        ADJUSTED_COLUMNS, (adjusted.std(ddof=1), *np.quantile(adjusted, [0.025, 0.975]))))
     return out
 
 

@@ -14,15 +14,13 @@ from harvester.plots.posterior import SIMULATED_NOTE  # noqa: E402
 from harvester.plots.style import (BOUNDS, HIGHLIGHT, LEGEND_SIZE, MEASURED, MODEL,  # noqa: E402
                                    TITLE_SIZE, save_figure)
 from harvester.inference.predictive import PredictiveBand  # noqa: E402
-from harvester.study.sticking import StickMisfit  # noqa: E402
+from harvester.study.sticking import StickMisfit, stick_runs  # noqa: E402
 
 
 def _spans(t: np.ndarray, mask: np.ndarray) -> list[tuple[float, float]]:
     """(start, stop) times (s) of the runs of True in ``mask``, half a step either side."""
     dt = float(t[1] - t[0]) if t.size > 1 else 0.0
-    edge = np.diff(np.r_[0, mask.astype(int), 0])
-    return [(t[a] - dt / 2, t[b - 1] + dt / 2)
-            for a, b in zip(np.flatnonzero(edge == 1), np.flatnonzero(edge == -1))]
+    return [(t[a] - dt / 2, t[b - 1] + dt / 2) for a, b in zip(*stick_runs(mask))]
 
 
 def _draw(ax, band: PredictiveBand, measured: np.ndarray, sel, k: float, lw: float,

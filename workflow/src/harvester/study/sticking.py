@@ -36,6 +36,20 @@ def near_sticks(stuck: np.ndarray, fs: float, near_s: float = NEAR_S) -> np.ndar
     return near
 
 
+def longest_stick_window(stuck: np.ndarray, time: np.ndarray,
+                         width_s: float) -> tuple[float, float] | None:
+    """(start, end) s of a ``width_s`` section centred on the longest stick and kept inside
+    ``time``; None without a stick (Figure 7's zoom)."""
+    runs = list(zip(*stick_runs(stuck)))
+    if not runs:
+        return None
+    a, b = max(runs, key=lambda r: r[1] - r[0])
+    half = 0.5 * float(width_s)
+    mid = 0.5 * (time[a] + time[b - 1])
+    lo = min(max(mid - half, time[0]), time[-1] - 2 * half)
+    return lo, lo + 2 * half
+
+
 @dataclass(frozen=True)
 class StickMisfit:
     """A model's misfit near the rig's sticks against elsewhere, and per band of speed."""
