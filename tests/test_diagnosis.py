@@ -454,13 +454,16 @@ def test_a_candidate_piled_where_it_stands_for_another_term_brings_that_term_in(
 
     tanh = structure("tanh")
     piled = SimpleNamespace(effect="hysteresis", at_prior_edge={"delta_hyst": "lower"})
-    assert limit_candidates(piled, tanh, ["hysteresis"]) == ["coulomb_friction"]
-    assert limit_candidates(piled, tanh, ["hysteresis", "coulomb_friction"]) == []
+    assert limit_candidates("hysteresis", piled.at_prior_edge, tanh, ["hysteresis"]) == [
+        "coulomb_friction"]
+    assert limit_candidates("hysteresis", piled.at_prior_edge, tanh,
+                            ["hysteresis", "coulomb_friction"]) == []
     other_side = SimpleNamespace(effect="hysteresis", at_prior_edge={"delta_hyst": "upper"})
-    assert limit_candidates(other_side, tanh, ["hysteresis"]) == []
+    assert limit_candidates("hysteresis", other_side.at_prior_edge, tanh, ["hysteresis"]) == []
     # a mode's modal mass is part of the stated masses: far above the band it is no mass error
     mode = SimpleNamespace(effect="unmodelled_mode", at_prior_edge={"f_mode": "upper"})
-    assert limit_candidates(mode, tanh, ["unmodelled_mode"]) == []
+    assert limit_candidates("unmodelled_mode", mode.at_prior_edge, tanh,
+                            ["unmodelled_mode"]) == []
     # and the term it becomes is that term's physics, not a rival explanation of it
     from harvester.diagnosis.confirm import becomes
 
@@ -543,3 +546,134 @@ def test_map_solves_from_several_starts_keep_the_best_end() -> None:
     two = fit_map(_TwoBasins(), priors, n_starts=0, start=starts, solves=2).theta[0]
     assert one < -0.9
     assert abs(two - 1.0) < 1e-3
+
+
+class _Level:
+    """A stand-in problem with two parameters: a level a that the n data put at ``truth``
+    (residuals truth - a plus a fixed pattern of RMS ``noise``), and b, which the data see
+    only through ``b_effect`` b (zero: a direction the record cannot see)."""
+
+    class structure:  # noqa: N801 (the attributes fit_map reads)
+        free_parameters = ("a", "b")
+        name = "level"
+
+    parameter_names = ("a", "b", "sigma")
+    temper = 1.0
+
+    def __init__(self, truth: float, noise: float, n: int, b_effect: float = 0.0):
+        self.truth, self.n_data, self.b_effect = truth, n, b_effect
+        self.pattern = noise * np.sqrt(2.0) * np.sin(np.arange(n) * 0.7)
+        self.measured_chain = np.zeros(n)
+
+    def residuals(self, theta: np.ndarray) -> np.ndarray:
+        theta = np.atleast_2d(theta)
+        shift = self.truth - theta[:, :1] - self.b_effect * theta[:, 1:2]
+        return shift + self.pattern[None, :]
+
+    def residual_sums(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        sse = np.sum(self.residuals(theta) ** 2, axis=1)
+        return sse, np.ones(len(sse), dtype=bool)
+
+    def predicted(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return -self.residuals(theta), np.ones(len(np.atleast_2d(theta)), dtype=bool)
+
+
+def _exact_draws(problem: "_Level", spec: PriorSpec, b: float, n: int = 4000) -> np.ndarray:
+    """Exact posterior draws of a (b fixed; flat prior in ln a, sigma profiled as fit_map
+    does) by the inverse of its distribution function on a fine grid."""
+    u = np.linspace(spec.bounds[0], spec.bounds[1], 20001)
+    a = np.exp(u)
+    sse = np.sum(problem.residuals(np.column_stack([a, np.full_like(a, b)])) ** 2, axis=1)
+    logp = -0.5 * problem.temper * problem.n_data * np.log(sse)
+    cdf = np.cumsum(np.exp(logp - logp.max()))
+    return a[np.searchsorted(cdf / cdf[-1], (np.arange(n) + 0.5) / n)]
+
+
+def test_a_map_on_a_bound_is_reported_only_where_the_posterior_must_pile_there() -> None:
+    """``bound_pull``: a level the data put at 2 with a log-uniform prior up to 1 has its MAP
+    on the upper bound, the posterior falling 23 nats over 5 % of the prior's width inside
+    (the closed form's): reported, and the exact
+    posterior piles there (``at_prior_edge``). With 5 data points of noise 3 the MAP is on
+    the same bound but the posterior spreads over the prior: not reported, and the exact
+    posterior does not pile. b, which the data barely see, drifts to a bound without a slope:
+    never reported. A level inside its prior is not on a bound."""
+    from harvester.diagnosis.baseline import PILE_NATS, bound_pull, fit_map
+    from harvester.diagnosis.detect import EDGE_SHARE, at_prior_edge
+    priors = {"a": PriorSpec.log_uniform("a", 0.1, 1.0, "-"),
+              "b": PriorSpec.log_uniform("b", 0.1, 1.0, "-")}
+    for truth, noise, n, piles in ((2.0, 0.1, 200, True), (2.0, 3.0, 5, False)):
+        problem = _Level(truth, noise, n, b_effect=1e-9)
+        point = fit_map(problem, priors, n_starts=8, start=np.array([[0.5, 0.99]]))
+        assert point.theta[0] == pytest.approx(1.0, rel=1e-3)  # on the upper bound
+        found = bound_pull(problem, priors, point, ("a", "b"), EDGE_SHARE)
+        pulled = {n: v for n, v in found.items() if v[1] > PILE_NATS}
+        exact = at_prior_edge(priors["a"], _exact_draws(problem, priors["a"], point.theta[1]))
+        assert ("a" in pulled) is piles and (exact == "upper") is piles
+        assert "b" not in pulled
+        if piles:  # the slope in ln a at a = 1 is n (truth - 1) / (noise^2 + (truth - 1)^2)
+            slope = n * (truth - 1.0) / (noise**2 + (truth - 1.0) ** 2)
+            assert pulled["a"][0] == "upper"
+            assert pulled["a"][1] == pytest.approx(slope * EDGE_SHARE * np.log(10.0), rel=0.02)
+    inside = _Level(0.5, 0.1, 200)
+    point = fit_map(inside, priors, n_starts=8)
+    assert bound_pull(inside, priors, point, ("a", "b"), EDGE_SHARE) == {}
+
+
+def test_a_candidate_pulled_against_a_bound_is_sampled_last_and_only_to_tie() -> None:
+    """A candidate whose best fit lies on a bound its posterior must pile against cannot be
+    named (``judge`` does not trust it): it is sampled after the others, and only where a
+    candidate accepted before it leaves a tie to make."""
+    from harvester.diagnosis.confirm import ConfirmSettings, sampling_order, skip_reason
+    cs = ConfirmSettings()
+    mode, asym, cubic = (_screened("unmodelled_mode", 167.0), _screened("asymmetric_friction",
+                                                                         93.0),
+                         _screened("cubic_stiffness", 50.0))
+    mode.on_bound = {"zeta_mode": ("lower", 40.0)}
+    asym.on_bound = {"v_asym": ("upper", 12.0)}
+    cubic.on_bound = {"k_cubic": ("lower", 1.0)}  # on its bound, but the posterior need not pile
+    fitted = {s.effect: s for s in (mode, asym, cubic)}
+    order, pulled = sampling_order([s.effect for s in (mode, asym, cubic)], fitted)
+    assert order == ["cubic_stiffness", "unmodelled_mode", "asymmetric_friction"]
+    assert pulled == {"unmodelled_mode", "asymmetric_friction"}
+    assert "pile" in skip_reason(mode, [], cs, 3)                      # nothing to tie with
+    assert "pile" in skip_reason(mode, [_result("cubic", 48.0, accepted=False)], cs, 3)
+    assert skip_reason(mode, [_result("cubic_stiffness", 166.0)], cs, 3) is None  # may tie
+    assert "gained" in skip_reason(asym, [_result("cubic_stiffness", 166.0)], cs, 3)
+    mode.failed = True  # a failed fit's bound means nothing: its own rule decides
+    assert "pile" not in (skip_reason(mode, [], cs, 3) or "")
+
+
+def test_draws_of_a_trusted_importance_estimate_follow_the_exact_posterior() -> None:
+    """``Screened.importance_draws``, which judges a candidate pulled against a bound in
+    place of TMCMC (``confirm.judged_by_importance``): on the level whose posterior piles
+    against its prior's upper bound, the estimate is trusted, its draws pile there as the
+    exact posterior's do, and their mean and sd of ln a match the exact ones."""
+    from types import SimpleNamespace
+
+    from harvester.diagnosis.baseline import fit_map
+    from harvester.diagnosis.confirm import judged_by_importance
+    from harvester.diagnosis.detect import at_prior_edge
+    from harvester.diagnosis.screen import Screened, importance_evidence
+    specs = {"a": PriorSpec.log_uniform("a", 0.1, 1.0, "-"),
+             "b": PriorSpec.log_uniform("b", 0.1, 1.0, "-"),
+             "sigma": PriorSpec.log_uniform("sigma", 1e-3, 10.0, "-")}
+    problem = _Level(2.0, 0.1, 200, b_effect=1e-9)
+    point = fit_map(problem, specs, n_starts=8, start=np.array([[0.5, 0.5]]))
+    rng = np.random.default_rng(1)
+    nested = SimpleNamespace(names=("b", "sigma"), samples=np.column_stack(
+        [np.exp(rng.uniform(np.log(0.1), 0.0, 400)), np.full(400, 1.0)]))
+    est = importance_evidence(problem, specs, point, nested, seed=0)
+    assert est.reliable
+    screened = Screened("level", problem.parameter_names, point.theta, 0.0, 10.0, 20.0, False,
+                        0, 0.0, problem=problem, specs=specs)
+    screened.importance = est
+    draws = screened.importance_draws(2000, seed=0)
+    exact = np.log(_exact_draws(problem, specs["a"], 0.5))
+    got = np.log(draws[:, 0])
+    assert at_prior_edge(specs["a"], draws[:, 0]) == "upper"
+    assert abs(got.mean() - exact.mean()) < 0.2 * exact.std()
+    assert got.std() == pytest.approx(exact.std(), rel=0.3)
+    assert np.allclose(draws[:, 2], np.sqrt(np.sum(problem.residuals(draws) ** 2, axis=1)
+                                            / problem.n_data))
+    # where the estimate is not trusted, TMCMC decides
+    assert judged_by_importance(None, "level", screened, None, 0) is None

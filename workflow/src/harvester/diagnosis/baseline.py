@@ -271,11 +271,7 @@ def fit_map(problem: ChainProblem, priors: Mapping[str, PriorSpec], n_starts: in
         return problem.residuals(theta)
 
     def objective_rows(us: np.ndarray) -> np.ndarray:
-        r = resid_u(us)
-        with np.errstate(invalid="ignore"):
-            val = 0.5 * temper * n * np.log(np.sum(r * r, axis=1)) + 0.5 * np.sum(w * us * us,
-                                                                                  axis=1)
-        return np.where(np.isfinite(val), val, np.inf)
+        return _objective(resid_u(us), us, w, temper, n)
 
     extra = None if start is None else np.array([coords.u(row) for row in np.atleast_2d(start)])
     ends = [_least_squares(resid_u, u0, coords, temper, n)
@@ -283,6 +279,64 @@ def fit_map(problem: ChainProblem, priors: Mapping[str, PriorSpec], n_starts: in
     u = ends[int(np.argmin(objective_rows(np.array(ends))))] if len(ends) > 1 else ends[0]
     sigma_prior = priors.get("sigma")  # None: no Laplace evidence (sigma has no default)
     return _point_fit(problem, coords, u, resid_u, temper, n, count, sigma_prior)
+
+
+def _objective(r: np.ndarray, us: np.ndarray, w: np.ndarray, temper: float, n: int
+               ) -> np.ndarray:
+    """fit_map's objective of rows u from their residual rows r: minus the log posterior in u
+    with sigma profiled, up to a constant (nats; inf where a simulation failed)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        val = 0.5 * temper * n * np.log(np.sum(r * r, axis=1)) + 0.5 * np.sum(w * us * us,
+                                                                              axis=1)
+    return np.where(np.isfinite(val), val, np.inf)
+
+
+#: A MAP within this share of its prior's width (in prior coordinates) of a bound lies on it.
+ON_BOUND = 1e-4
+#: The step inward, as a share of the width, over which the slope at a bound is taken.
+SLOPE_STEP = 2e-3
+#: Nats by which the posterior falls, at the MAP's slope, over EDGE_SHARE of the prior's
+#: width from the bound, beyond which it is sure to pile there: 95 % of an exponential's mass.
+PILE_NATS = float(np.log(20.0))
+
+
+def bound_pull(problem: ChainProblem, priors: Mapping[str, PriorSpec], point: PointFit,
+               names: tuple[str, ...], edge_share: float) -> dict[str, tuple[str, float]]:
+    """Parameters of ``names`` whose MAP (``point``) lies on a bound of their prior: {name:
+    (side, nats the log posterior falls over ``edge_share`` of the prior's width from the
+    bound)}. Where it falls by more than PILE_NATS the posterior must pile against the bound.
+
+    The slope is that of fit_map's objective along the parameter, inward over SLOPE_STEP of
+    the width, the others held at the MAP. At a constrained optimum that is the slope of the
+    profile posterior too (the envelope theorem), and a log-concave profile falls at least as
+    fast as its tangent, so the marginal posterior has at least 1 - exp(-drop) of its mass
+    within ``edge_share`` of the width from the bound. A flat direction (a bristle damping
+    the record cannot see, whose MAP drifted to its bound) has no slope: its posterior
+    spreads over the prior."""
+    coords = PriorCoordinates.of(problem, priors)
+    low, high = coords.bounds()
+    u = coords.u(point.theta[:-1])
+    free = list(problem.structure.free_parameters)
+    rows, sides = [u], []
+    for name in names:
+        j = free.index(name)
+        # a prior open on one side is judged on 6 of its scales, as ``detect.at_prior_edge``
+        width = high[j] - low[j] if np.isfinite(high[j] - low[j]) else 6.0
+        for side, bound, inward in (("lower", low[j], 1.0), ("upper", high[j], -1.0)):
+            if np.isfinite(bound) and abs(u[j] - bound) <= ON_BOUND * width:
+                step = u.copy()
+                step[j] += inward * SLOPE_STEP * width
+                rows.append(step)
+                sides.append((name, side, width))
+    if not sides:
+        return {}
+    us = np.array(rows)
+    theta = np.column_stack([coords.theta(us), np.ones(len(us))])
+    value = _objective(problem.residuals(theta), us, coords.penalty, problem.temper,
+                       problem.n_data)
+    return {name: (side, float((v - value[0]) / SLOPE_STEP * edge_share)
+                   if np.isfinite(v) else np.inf)
+            for (name, side, width), v in zip(sides, value[1:])}
 
 
 def _best_starts(coords: PriorCoordinates, n_starts: int, seed: int, objective,

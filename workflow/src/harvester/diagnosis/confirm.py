@@ -389,9 +389,12 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
     ``detection``: the round's detection, whose scans place the start of candidates with a
     ``Probe.start_shape`` (:func:`candidate_reference`). ``screen``: the candidates' best
     fits (``diagnosis.screen``); then they are sampled in its order, at most ``top`` of them,
-    and one whose evidence bound rules it out is not sampled (:func:`skip_reason`)."""
+    and one whose evidence bound rules it out is not sampled (:func:`skip_reason`). Those
+    whose best fit lies on a bound their posterior must pile against (``Screened.pulled``)
+    come last: they can only tie with a candidate accepted before them."""
     fitted = {s.effect: s for s in screen.candidates} if screen is not None else {}
-    order = list(screen.order if screen is not None else effects)
+    order, pulled = sampling_order(list(screen.order if screen is not None else effects),
+                                   fitted)
     single = detection is not None and not (detection.significant or detection.conflict)
     results = []
     i = -1
@@ -404,34 +407,80 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
         if reason is not None:
             screened.skipped = reason
             log.info("%s not sampled: %s", effect, reason)
+            if effect in pulled:
+                edges = {n: side for n, (side, _) in screened.pulled.items()}
+                order[i + 1:i + 1] = limit_candidates(effect, edges, baseline.structure, order)
             continue
         log.info("confirming %s (%d of %d)", baseline.structure.with_term(effect).name, i + 1,
                  len(order))
-        point = screened.point if screened is not None and not screened.failed else None
-        fit = candidate_fit(baseline, effect, priors, settings, scale, detection,
-                            seed_offset + 101 * (i + 1), decisions(baseline, results, settings),
-                            point)
-        results.append(judge(effect, fit, baseline, settings))
+        result = judged_by_importance(baseline, effect, screened, settings,
+                                      seed_offset + 101 * (i + 1)) \
+            if screened is not None and screened.on_bound and not screened.failed else None
+        if result is None:
+            point = screened.point if screened is not None and not screened.failed else None
+            fit = candidate_fit(baseline, effect, priors, settings, scale, detection,
+                                seed_offset + 101 * (i + 1),
+                                decisions(baseline, results, settings), point)
+            result = judge(effect, fit, baseline, settings)
+        results.append(result)
         if screened is not None:
             screened.sampled = True
-        order[i + 1:i + 1] = limit_candidates(results[-1], baseline.structure, order)
+        order[i + 1:i + 1] = limit_candidates(effect, results[-1].at_prior_edge,
+                                              baseline.structure, order)
     results.sort(key=lambda r: -r.delta_log_evidence)
     mark_ties(results, settings)
     return results
 
 
-def limit_candidates(result: CandidateResult, structure: ModelStructure,
+def judged_by_importance(baseline: ModelFit, effect: str, screened, settings: ConfirmSettings,
+                         seed: int) -> CandidateResult | None:
+    """The result of a candidate whose best fit lies on a bound of its prior
+    (``Screened.on_bound``), judged on draws from its trusted importance-sampling estimate
+    (``Screened.importance_draws``) instead of TMCMC where those draws pile against a bound:
+    then the candidate cannot be named (:func:`judge`), only its evidence, for a tie, is at
+    stake, and the estimate gives it. None (TMCMC decides) where the estimate is not
+    trusted or its draws do not pile."""
+    if not screened.importance_trusted:
+        return None
+    est, p = screened.importance, screened.problem
+    chains = max(settings.chains, 1)
+    samples = screened.importance_draws(chains * candidate_particles(effect, settings.particles),
+                                        settings.seed + seed)
+    fit = ModelFit(baseline.structure.with_term(effect), p, samples,
+                   np.array([est.log_evidence]), None, priors_for(p, screened.specs),
+                   importance=est)
+    result = judge(effect, fit, baseline, settings)
+    if not result.at_prior_edge:
+        log.info("%s: the draws of its importance-sampling estimate do not pile against a "
+                 "bound: sampled by TMCMC", fit.structure.name)
+        return None
+    log.info("%s: judged on %d draws of its importance-sampling estimate (log evidence %.2f "
+             "+- %.2f, Pareto k %.2f, ESS %.0f of %d), not by TMCMC: its best fit has %s",
+             fit.structure.name, len(samples), est.log_evidence, est.se, est.pareto_k,
+             est.ess, est.draws, screened.pull_phrase(screened.on_bound))
+    return result
+
+
+def sampling_order(order: list[str], fitted: Mapping) -> tuple[list[str], set[str]]:
+    """``order`` with the candidates whose best fit lies on a bound their posterior must pile
+    against (``Screened.pulled``, of ``fitted``: effect -> Screened) moved behind the others,
+    each group in its order; and the set of those."""
+    pulled = {e for e in order if e in fitted and fitted[e].pulled and not fitted[e].failed}
+    return [e for e in order if e not in pulled] + [e for e in order if e in pulled], pulled
+
+
+def limit_candidates(effect: str, edges: Mapping[str, str], structure: ModelStructure,
                      order: list[str]) -> list[str]:
-    """The terms a candidate stands for where its posterior piled against a bound
-    (``Term.limits``), that the structure can take and the round has not listed: sampled
-    next, in its place (unscreened, so always)."""
+    """The terms a candidate stands for where its posterior piled, or its best fit lies,
+    against a bound (``edges``: name -> side; ``Term.limits``), that the structure can take
+    and the round has not listed: sampled next, in its place (unscreened, so always)."""
     allowed = set(candidate_terms(structure.terms))
     out = []
-    for name, side in result.at_prior_edge.items():
-        other = term(result.effect).limit(name, side)
+    for name, side in edges.items():
+        other = term(effect).limit(name, side)
         if other and other in allowed and other not in order and other not in out:
             log.info("%s: %s piles against its %s bound, where the term stands for %s: "
-                     "sampling %s too", result.effect, name, side, other, other)
+                     "sampling %s too", effect, name, side, other, other)
             out.append(other)
     return out
 
@@ -452,11 +501,17 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     stiff contacts spend a quarter of an hour (the backlash on the literature grid, never
     accepted). In a round opened by single effects' scores (``single_scores``: the family's
     test not significant, no conflict), or once another candidate was accepted, it is not
-    even estimated. None: sample it (always where it was not screened)."""
+    even estimated. A candidate whose best fit lies on a bound its posterior must pile
+    against (``Screened.pulled``) would not be trusted (:func:`judge`), so it cannot be
+    named; it is sampled only where a candidate accepted before it leaves it a tie to make.
+    None: sample it (always where it was not screened)."""
     if screened is None:
         return None
     if top is not None and len(results) >= top:
         return f"the round's {top} best by their fits were sampled"
+    if screened.pulled and not screened.failed and not any(r.accepted for r in results):
+        return (f"its best fit has {screened.pull_phrase()}: its posterior would pile there "
+                "and not be trusted, and no candidate was accepted for it to tie with")
     least = settings.acceptance_base + settings.mc_sigmas * float(np.hypot(nested_se,
                                                                            BRIDGE_MIN_SE))
     if screened.failed:  # its bound means nothing; a trusted estimate still does

@@ -20,6 +20,7 @@ import numpy as np
 from harvester.diagnosis.baseline import ChainProblem
 from harvester.diagnosis.detect import Detection
 from harvester.inference.evidence import BridgeEstimate
+from harvester.inference.importance import ImportanceEstimate
 from harvester.inference.posterior import pooled_log_evidence
 from harvester.inference.priors import PriorSpec
 from harvester.inference.reference import Reference, ScanFactor
@@ -40,7 +41,9 @@ BRIDGE_MIN_SE = 0.1
 
 @dataclass
 class ModelFit:
-    """A structure sampled by TMCMC under the diagnosis's likelihood."""
+    """A structure sampled by TMCMC under the diagnosis's likelihood, or, for a candidate
+    that can only be judged untrusted (``confirm.importance_fit``), drawn by importance
+    sampling (``importance``; then ``log_evidence_chains`` holds its one estimate)."""
 
     structure: ModelStructure
     problem: ChainProblem
@@ -53,6 +56,7 @@ class ModelFit:
     restarted: bool = False  # the reference start collapsed; sampled again from the prior
     #: (particles, spread of the chains' log evidences) of each run that was enlarged
     enlarged: list[tuple[int, float]] = field(default_factory=list)
+    importance: ImportanceEstimate | None = None
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -60,7 +64,10 @@ class ModelFit:
 
     @property
     def log_evidence(self) -> float:
-        """The bridge-sampling estimate where it was made, else TMCMC's pooled over chains."""
+        """The bridge-sampling estimate where it was made, else the importance-sampling one
+        where the fit was drawn by it, else TMCMC's pooled over chains."""
+        if self.bridge is None and self.importance is not None:
+            return self.importance.log_evidence
         return self.bridge.log_evidence if self.bridge else self.tmcmc_log_evidence
 
     @property
@@ -73,6 +80,8 @@ class ModelFit:
         TMCMC's (:meth:`tmcmc_log_evidence_se`)."""
         if self.bridge is not None:
             return float(max(self.bridge.se, BRIDGE_MIN_SE))
+        if self.importance is not None:
+            return float(max(self.importance.se, BRIDGE_MIN_SE))
         return self.tmcmc_log_evidence_se
 
     @property
@@ -97,8 +106,11 @@ class ModelFit:
 
     def evidence_dict(self) -> dict:
         """Both estimates of the log evidence, and which one ``log_evidence`` is."""
+        method = "bridge" if self.bridge else "importance" if self.importance else "tmcmc"
         return {"log_evidence": self.log_evidence, "log_evidence_se": self.log_evidence_se,
-                "log_evidence_method": "bridge" if self.bridge else "tmcmc",
+                "log_evidence_method": method,
+                "log_evidence_importance": self.importance.to_dict() if self.importance
+                else None,
                 "log_evidence_tmcmc": self.tmcmc_log_evidence,
                 "log_evidence_chains": [float(x) for x in self.log_evidence_chains],
                 "chains_missing_the_mode": self.missed_chains,

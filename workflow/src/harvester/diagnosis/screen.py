@@ -59,11 +59,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from harvester.diagnosis.baseline import PointFit, PriorCoordinates, chain_problem, fit_map
+from harvester.diagnosis.baseline import (PILE_NATS, PointFit, PriorCoordinates, bound_pull,
+                                          chain_problem, fit_map)
 from harvester.diagnosis.fits import ModelFit, candidate_priors, scan_factor
-from harvester.diagnosis.detect import Detection
+from harvester.diagnosis.detect import EDGE_SHARE, Detection
 from harvester.inference.importance import (Component, ImportanceEstimate, MixtureProposal,
-                                            importance_log_evidence)
+                                            importance_log_evidence, resample)
 from harvester.inference.likelihood import sigma_marginal_loglike
 from harvester.inference.priors import PriorSpec, priors_for
 from harvester.model.priors import DeviceScale
@@ -117,6 +118,37 @@ class Screened:
     importance_trusted: bool = False  # reliable, and the round's check of the nested passed
     #: makes the estimate on first use (:meth:`importance_ceiling`); None once made
     pending: Callable[[], None] | None = field(default=None, repr=False)
+    #: added parameters whose MAP lies on a bound of their prior (``baseline.bound_pull``):
+    #: {name: (side, nats the posterior falls over EDGE_SHARE of the width from it)}
+    on_bound: dict[str, tuple[str, float]] = field(default_factory=dict)
+
+    @property
+    def pulled(self) -> dict[str, tuple[str, float]]:
+        """Those of ``on_bound`` whose posterior must pile against the bound (a fall above
+        PILE_NATS)."""
+        return {n: v for n, v in self.on_bound.items() if v[1] > PILE_NATS}
+    #: the candidate's problem and priors, as its fit and its estimate used them
+    problem: object = field(default=None, repr=False)
+    specs: dict[str, PriorSpec] = field(default_factory=dict, repr=False)
+
+    def importance_draws(self, n: int, seed: int) -> np.ndarray:
+        """n draws of the candidate's posterior from its importance-sampling estimate
+        (``importance.resample``): rows (free parameters..., sigma), sigma at sqrt(SSE / n) of
+        each row, where eq. (10)'s likelihood peaks over sigma whatever its tempering."""
+        coords = PriorCoordinates.of(self.problem, self.specs)
+        theta = coords.theta(resample(self.importance, n, np.random.default_rng(seed)))
+        unique, inverse = np.unique(theta, axis=0, return_inverse=True)
+        sse, ok = self.problem.residual_sums(np.column_stack([unique, np.ones(len(unique))]))
+        sigma = np.sqrt(np.where(ok, sse, np.nan) / self.problem.n_data)
+        return np.column_stack([theta, sigma[np.ravel(inverse)]])
+
+    def pull_phrase(self, bounds: dict[str, tuple[str, float]] | None = None) -> str:
+        """``bounds`` (default ``pulled``) in words, for logs and the reasons a candidate
+        was not sampled."""
+        return ", ".join(f"{n} on its {side} bound, the posterior {drop:.1f} nats lower "
+                         f"{EDGE_SHARE:.0%} of the prior's width inside"
+                         for n, (side, drop) in (self.pulled if bounds is None
+                                                 else bounds).items())
 
     def importance_ceiling(self, mc_sigmas: float) -> float | None:
         """The most evidence the importance-sampling estimate lets this candidate gain
@@ -151,6 +183,9 @@ class Screened:
                     **self.importance.to_dict(), "evidence_gain": self.importance_gain,
                     "evidence_gain_se": self.importance_gain_se,
                     "trusted": self.importance_trusted},
+                "map_on_bound": {n: {"side": side, "drop_nats": drop,
+                                     "posterior_must_pile": drop > PILE_NATS}
+                                 for n, (side, drop) in self.on_bound.items()},
                 "sampled": self.sampled, "skipped": self.skipped}
 
 
@@ -318,7 +353,9 @@ def _screen_one(nested: ModelFit, effect: str, priors: Mapping[str, PriorSpec],
     gain = value - so_far.nested_value
     out = Screened(effect, problem.parameter_names, fit.theta, ll, gain + GAIN_SLACK,
                    ll - nested.log_evidence, not gain >= -GAIN_SLACK, fit.n_simulations,
-                   0.0, fit.log_evidence_laplace - so_far.nested_laplace, point=fit)
+                   0.0, fit.log_evidence_laplace - so_far.nested_laplace, point=fit,
+                   problem=problem, specs=specs)
+    out.on_bound = bound_pull(problem, specs, fit, term(effect).parameter_names, EDGE_SHARE)
     out.seconds = time.perf_counter() - clock
 
     def estimate() -> None:

@@ -22,7 +22,7 @@ parameters at their prior, where the added effect is absent).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import arviz as az
 import numpy as np
@@ -32,7 +32,7 @@ from scipy.special import logsumexp
 from harvester.inference.tmcmc import fit_gaussian_mixture
 
 __all__ = ["Component", "ImportanceEstimate", "MixtureProposal", "importance_estimate",
-           "importance_log_evidence"]
+           "importance_log_evidence", "resample"]
 
 #: Pareto k below which an importance-sampling estimate is trusted (PSIS's threshold for
 #: estimates of a mean, Vehtari et al. 2024, sec. 3).
@@ -114,6 +114,9 @@ class ImportanceEstimate:
     pareto_k: float
     ess: float
     draws: int
+    #: the draws (rows of the proposal's coordinates) and their log weights, where kept
+    u: np.ndarray | None = field(default=None, repr=False, compare=False)
+    log_w: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     @property
     def reliable(self) -> bool:
@@ -138,6 +141,15 @@ def importance_estimate(log_w: np.ndarray) -> ImportanceEstimate:
     se = float(w.std(ddof=1) / (mean * np.sqrt(n)))
     ess = float(w.sum() ** 2 / np.sum(w * w))
     return ImportanceEstimate(float(top + np.log(mean)), se, pareto_k(log_w), ess, n)
+
+
+def resample(est: ImportanceEstimate, n: int, rng: np.random.Generator) -> np.ndarray:
+    """n rows of ``est``'s draws picked by their Pareto-smoothed weights (ArviZ's PSIS):
+    draws from the target as far as the estimate holds (its Pareto k)."""
+    keep = np.flatnonzero(np.isfinite(est.log_w))
+    smoothed, _ = az.psislw(est.log_w[keep])
+    w = np.exp(smoothed - smoothed.max())
+    return est.u[keep[rng.choice(len(keep), size=n, p=w / w.sum())]]
 
 
 def pareto_k(log_w: np.ndarray) -> float:
@@ -174,7 +186,7 @@ def _estimate(log_target, proposal: MixtureProposal, n: int, rng: np.random.Gene
     with np.errstate(invalid="ignore"):
         log_w = np.asarray(log_target(u), dtype=float) - log_q
     log_w = np.where(np.isfinite(log_w), log_w, -np.inf)
-    return importance_estimate(log_w), u, log_w
+    return replace(importance_estimate(log_w), u=u, log_w=log_w), u, log_w
 
 
 #: Share of an adapted proposal's non-prior weight that goes to the fitted mixture, its most
