@@ -675,5 +675,8 @@ def test_draws_of_a_trusted_importance_estimate_follow_the_exact_posterior() -> 
     assert got.std() == pytest.approx(exact.std(), rel=0.3)
     assert np.allclose(draws[:, 2], np.sqrt(np.sum(problem.residuals(draws) ** 2, axis=1)
                                             / problem.n_data))
-    # where the estimate is not trusted, TMCMC decides
+    # where the estimate is not trusted, TMCMC decides, even for a MAP on a bound
+    screened.on_bound = {"a": ("upper", 22.7)}
+    assert not screened.importance_trusted
     assert judged_by_importance(None, "level", screened, None, 0) is None
+    assert judged_by_importance(None, "level", None, None, 0) is None  # not screened

@@ -327,7 +327,7 @@ def bound_pull(problem: ChainProblem, priors: Mapping[str, PriorSpec], point: Po
                 step = u.copy()
                 step[j] += inward * SLOPE_STEP * width
                 rows.append(step)
-                sides.append((name, side, width))
+                sides.append((name, side))
     if not sides:
         return {}
     us = np.array(rows)
@@ -336,7 +336,7 @@ def bound_pull(problem: ChainProblem, priors: Mapping[str, PriorSpec], point: Po
                        problem.n_data)
     return {name: (side, float((v - value[0]) / SLOPE_STEP * edge_share)
                    if np.isfinite(v) else np.inf)
-            for (name, side, width), v in zip(sides, value[1:])}
+            for (name, side), v in zip(sides, value[1:])}
 
 
 def _best_starts(coords: PriorCoordinates, n_starts: int, seed: int, objective,

@@ -414,8 +414,7 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
         log.info("confirming %s (%d of %d)", baseline.structure.with_term(effect).name, i + 1,
                  len(order))
         result = judged_by_importance(baseline, effect, screened, settings,
-                                      seed_offset + 101 * (i + 1)) \
-            if screened is not None and screened.on_bound and not screened.failed else None
+                                      seed_offset + 101 * (i + 1))
         if result is None:
             point = screened.point if screened is not None and not screened.failed else None
             fit = candidate_fit(baseline, effect, priors, settings, scale, detection,
@@ -439,8 +438,9 @@ def judged_by_importance(baseline: ModelFit, effect: str, screened, settings: Co
     (``Screened.importance_draws``) instead of TMCMC where those draws pile against a bound:
     then the candidate cannot be named (:func:`judge`), only its evidence, for a tie, is at
     stake, and the estimate gives it. None (TMCMC decides) where the estimate is not
-    trusted or its draws do not pile."""
-    if not screened.importance_trusted:
+    trusted or its draws do not pile (and for a candidate not screened, or not on a bound)."""
+    if screened is None or screened.failed or not screened.on_bound \
+            or not screened.importance_trusted:
         return None
     est, p = screened.importance, screened.problem
     chains = max(settings.chains, 1)
@@ -515,21 +515,37 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     least = settings.acceptance_base + settings.mc_sigmas * float(np.hypot(nested_se,
                                                                            BRIDGE_MIN_SE))
     if screened.failed:  # its bound means nothing; a trusted estimate still does
-        if single_scores:
-            return ("its fit fell below the nested model's, and the round was opened by single "
-                    "effects' scores, not by the family's test")
-        accepted = [r.effect for r in results if r.accepted]
-        if accepted:  # not estimated either (100 s for a stiff contact): the next round
-            return (f"its fit fell below the nested model's and {accepted[0]} was accepted; "
-                    "the next round screens it again")
-        ceiling = screened.importance_ceiling(settings.mc_sigmas)
-        if ceiling is None:
-            return (f"its fit fell below the nested model's and {screened.importance_phrase()}"
-                    ": nothing supports it (the next round screens it again)")
-        if ceiling < least:
-            return (f"its fit fell below the nested model's; {screened.importance_phrase()}, "
-                    f"at most {ceiling:.1f}, below the acceptance threshold {least:.1f}")
-        return None
+        return _failed_fit_reason(screened, results, settings, least, single_scores)
+    return _fitted_reason(screened, results, settings, least)
+
+
+def _failed_fit_reason(screened, results: list[CandidateResult], settings: ConfirmSettings,
+                       least: float, single_scores: bool) -> str | None:
+    """:func:`skip_reason` for a candidate whose fit fell below the nested model's: only a
+    trusted importance-sampling estimate, and only in a round opened by the family's test
+    with nothing accepted yet, can leave it open (``least``: the acceptance threshold)."""
+    if single_scores:
+        return ("its fit fell below the nested model's, and the round was opened by single "
+                "effects' scores, not by the family's test")
+    accepted = [r.effect for r in results if r.accepted]
+    if accepted:  # not estimated either (100 s for a stiff contact): the next round
+        return (f"its fit fell below the nested model's and {accepted[0]} was accepted; "
+                "the next round screens it again")
+    ceiling = screened.importance_ceiling(settings.mc_sigmas)
+    if ceiling is None:
+        return (f"its fit fell below the nested model's and {screened.importance_phrase()}"
+                ": nothing supports it (the next round screens it again)")
+    if ceiling < least:
+        return (f"its fit fell below the nested model's; {screened.importance_phrase()}, "
+                f"at most {ceiling:.1f}, below the acceptance threshold {least:.1f}")
+    return None
+
+
+def _fitted_reason(screened, results: list[CandidateResult], settings: ConfirmSettings,
+                   least: float) -> str | None:
+    """:func:`skip_reason` for a candidate with a usable fit: its evidence bound, then its
+    trusted importance-sampling ceiling, against the acceptance threshold ``least`` and the
+    best accepted gain less the naming margin."""
     if screened.bound < least:
         return (f"its best fit gains at most {screened.bound:.1f} nats of evidence, below the "
                 f"acceptance threshold {least:.1f}")

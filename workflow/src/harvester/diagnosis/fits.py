@@ -42,7 +42,7 @@ BRIDGE_MIN_SE = 0.1
 @dataclass
 class ModelFit:
     """A structure sampled by TMCMC under the diagnosis's likelihood, or, for a candidate
-    that can only be judged untrusted (``confirm.importance_fit``), drawn by importance
+    that can only be judged untrusted (``confirm.judged_by_importance``), drawn by importance
     sampling (``importance``; then ``log_evidence_chains`` holds its one estimate)."""
 
     structure: ModelStructure

@@ -121,15 +121,15 @@ class Screened:
     #: added parameters whose MAP lies on a bound of their prior (``baseline.bound_pull``):
     #: {name: (side, nats the posterior falls over EDGE_SHARE of the width from it)}
     on_bound: dict[str, tuple[str, float]] = field(default_factory=dict)
+    #: the candidate's problem and priors, as its fit and its estimate used them
+    problem: object = field(default=None, repr=False)
+    specs: dict[str, PriorSpec] = field(default_factory=dict, repr=False)
 
     @property
     def pulled(self) -> dict[str, tuple[str, float]]:
         """Those of ``on_bound`` whose posterior must pile against the bound (a fall above
         PILE_NATS)."""
         return {n: v for n, v in self.on_bound.items() if v[1] > PILE_NATS}
-    #: the candidate's problem and priors, as its fit and its estimate used them
-    problem: object = field(default=None, repr=False)
-    specs: dict[str, PriorSpec] = field(default_factory=dict, repr=False)
 
     def importance_draws(self, n: int, seed: int) -> np.ndarray:
         """n draws of the candidate's posterior from its importance-sampling estimate

@@ -143,12 +143,18 @@ def importance_estimate(log_w: np.ndarray) -> ImportanceEstimate:
     return ImportanceEstimate(float(top + np.log(mean)), se, pareto_k(log_w), ess, n)
 
 
-def resample(est: ImportanceEstimate, n: int, rng: np.random.Generator) -> np.ndarray:
-    """n rows of ``est``'s draws picked by their Pareto-smoothed weights (ArviZ's PSIS):
-    draws from the target as far as the estimate holds (its Pareto k)."""
+def smoothed_weights(est: ImportanceEstimate) -> tuple[np.ndarray, np.ndarray]:
+    """(indices of ``est``'s draws with a finite weight, their Pareto-smoothed weights
+    (ArviZ's PSIS), largest 1), so that a few large weights do not dominate."""
     keep = np.flatnonzero(np.isfinite(est.log_w))
     smoothed, _ = az.psislw(est.log_w[keep])
-    w = np.exp(smoothed - smoothed.max())
+    return keep, np.exp(smoothed - smoothed.max())
+
+
+def resample(est: ImportanceEstimate, n: int, rng: np.random.Generator) -> np.ndarray:
+    """n rows of ``est``'s draws picked by their Pareto-smoothed weights: draws from the
+    target as far as the estimate holds (its Pareto k)."""
+    keep, w = smoothed_weights(est)
     return est.u[keep[rng.choice(len(keep), size=n, p=w / w.sum())]]
 
 
@@ -170,23 +176,23 @@ def importance_log_evidence(log_target: Callable[[np.ndarray], np.ndarray],
     new draws from the proposal joined with a Gaussian mixture fitted to the weighted draws
     (:func:`adapted`; population Monte Carlo, Cappe, Guillin, Marin and Robert 2004), the
     estimate then from the new draws alone."""
-    est, u, log_w = _estimate(log_target, proposal, n, rng)
+    est = _estimate(log_target, proposal, n, rng)
     for _ in range(adapt):
         if est.reliable or est.ess < 2.0:
             break
-        proposal = adapted(proposal, u, log_w, rng)
-        est, u, log_w = _estimate(log_target, proposal, n, rng)
+        proposal = adapted(proposal, est, rng)
+        est = _estimate(log_target, proposal, n, rng)
     return est
 
 
 def _estimate(log_target, proposal: MixtureProposal, n: int, rng: np.random.Generator
-              ) -> tuple[ImportanceEstimate, np.ndarray, np.ndarray]:
+              ) -> ImportanceEstimate:
     u = proposal.draw(rng, n)
     log_q = proposal.log_density(u)
     with np.errstate(invalid="ignore"):
         log_w = np.asarray(log_target(u), dtype=float) - log_q
     log_w = np.where(np.isfinite(log_w), log_w, -np.inf)
-    return replace(importance_estimate(log_w), u=u, log_w=log_w), u, log_w
+    return replace(importance_estimate(log_w), u=u, log_w=log_w)
 
 
 #: Share of an adapted proposal's non-prior weight that goes to the fitted mixture, its most
@@ -194,15 +200,14 @@ def _estimate(log_target, proposal: MixtureProposal, n: int, rng: np.random.Gene
 ADAPT_SHARE, ADAPT_COMPONENTS, ADAPT_WIDEN = 0.6, 3, 2.0
 
 
-def adapted(proposal: MixtureProposal, u: np.ndarray, log_w: np.ndarray,
+def adapted(proposal: MixtureProposal, est: ImportanceEstimate,
             rng: np.random.Generator) -> MixtureProposal:
-    """``proposal`` joined with a Gaussian mixture fitted to its draws u by their weights,
-    Pareto-smoothed so that a few large ones do not shrink it to a point
-    (``tmcmc.fit_gaussian_mixture``, sds widened by ADAPT_WIDEN), which takes ADAPT_SHARE
-    of the weight that is not the prior's."""
-    keep = np.isfinite(log_w)
-    smoothed, _ = az.psislw(log_w[keep])
-    w = np.exp(smoothed - smoothed.max())
+    """``proposal`` joined with a Gaussian mixture fitted to the draws of ``est`` (made
+    from it) by their Pareto-smoothed weights (:func:`smoothed_weights`, so that a few large
+    ones do not shrink it to a point; ``tmcmc.fit_gaussian_mixture``, sds widened by
+    ADAPT_WIDEN), which takes ADAPT_SHARE of the weight that is not the prior's."""
+    keep, w = smoothed_weights(est)
+    u = est.u
     mix = fit_gaussian_mixture(u[keep], w, ADAPT_COMPONENTS, rng, widen=ADAPT_WIDEN)
     rest = 1.0 - proposal.prior_weight
     old = tuple(Component(c.columns, c.mean, c.cov, c.weight * (1.0 - ADAPT_SHARE))
