@@ -245,6 +245,21 @@ def test_outcomes_named_tied_wrong_missed():
     assert table.loc["end_stop", "missed_rate"] == 0.4
 
 
+def test_a_named_terms_size_is_checked_against_the_generators_missing_force():
+    """named_size: the first term named alone, its own force's 95 % interval against the
+    truth's missing force RMS; NaN where nothing is named or the truth has none."""
+    sized = {**_diag("cubic_stiffness"), "missing_force": {"named_effects": [
+        {"term": "cubic_stiffness", "term_force_rms_N": 0.40,
+         "term_force_rms_interval_N": [0.35, 0.45]}]}}
+    truth = {**_truth("duffing", 0.5, 0), "literature": {"missing_force_rms_N": 0.41}}
+    assert det.named_size(truth, sized)["size_covered"] == 1.0
+    outside = {**truth, "literature": {"missing_force_rms_N": 0.5}}
+    row = det.score(outside, sized)
+    assert row["size_covered"] == 0.0 and row["size_lo_N"] == 0.35 and row["size_N"] == 0.4
+    assert np.isnan(det.named_size(truth, _diag())["size_covered"])
+    assert np.isnan(det.named_size(_truth("duffing", 0.5, 0), sized)["size_covered"])
+
+
 def _informed(diagnosis, lam=0.1, window=(1.0, 16.0), rate=256.0, alpha=0.05):
     return {**diagnosis, "measurement_chain": {"tempering_lambda": lam, "analysis_rate_hz": rate},
             "tmcmc_window_s": list(window), "settings": {"evidence_alpha": alpha}}

@@ -131,3 +131,121 @@ def test_the_frames_friction_sticks_and_slides_at_a_level_rising_with_the_load()
         mu = level[load] / (float(load) * 1e-3 * 9.81)
         assert 0.2 < mu < 0.4
     assert level["450"] > 1.5 * level["250"]
+
+
+def _named_beside(force, improved, theta, term_name, seconds=12.0):
+    """The missing force of ``force`` under the linear baseline, and the improved model
+    (``improved`` at ``theta``) beside it: (description, its share as the shapes read
+    theirs, the diagnosis's missing force with the effect's size)."""
+    from harvester.diagnosis.missing_force import NamedEffect, missing_force
+    from harvester.model.structures import structure
+    state = linear_state(recording(rk4_record(force, seconds), "rel_acc"))
+    named = NamedEffect(term_name, structure(improved), np.asarray(theta, dtype=float))
+    out = missing_force(state, named=[named], draws=40)
+    return out.description, out.sizes[0].explains, out
+
+
+def test_a_named_term_is_checked_against_the_missing_forces_shape():
+    """Coulomb friction (6 N) missing: the improved model with it at the truth has the
+    missing force's shape (friction, its family, is the best shape); a cubic spring in its
+    place explains almost none of it and is withheld (``verdict.withheld_names``). A force
+    periodic in z (outside the library) withholds the same cubic spring, and its
+    description stays in the verdict's place."""
+    from harvester.diagnosis.shapes import has_its_shape, library_terms
+    from types import SimpleNamespace
+
+    from harvester.diagnosis.settings import DiagnosisSettings
+    from harvester.diagnosis.verdict import Conclusion, FitJudgement, judge, withheld_names
+    coulomb = lambda z, v, t: 6.0 * np.tanh(v / 1e-3)  # noqa: E731
+    desc, share, _ = _named_beside(coulomb, "linear+coulomb_friction", [60.0, 6.0],
+                                   "coulomb_friction")
+    assert desc.best.name == "friction" and "coulomb_friction" in library_terms("friction")
+    assert share > 0.6 and has_its_shape(desc, ["coulomb_friction"], share)
+    desc, share, out = _named_beside(coulomb, "linear+cubic_stiffness", [60.0, 1e6],
+                                     "cubic_stiffness")
+    assert share < desc.best.share - 0.5
+    assert not has_its_shape(desc, ["cubic_stiffness"], share)
+    found = Conclusion("missing_physics", ["cubic_stiffness"], [], False, [], None, True)
+    assert "cubic_stiffness accepted by evidence" in withheld_names(found, out)
+    periodic = lambda z, v, t: 5.0 * np.sin(2 * np.pi * z / 0.02)  # noqa: E731
+    desc, share, out = _named_beside(periodic, "linear+cubic_stiffness", [60.0, 1e6],
+                                     "cubic_stiffness")
+    assert desc.best.name == "periodic in z" and library_terms("periodic in z") == ()
+    assert withheld_names(found, out) is not None
+    judged = judge(found, SimpleNamespace(p_value=1e-4, significant=True, conflict=False),
+                   FitJudgement(0.7, 0.55, "holdout", 2.0, None, 0.75), "linear",
+                   DiagnosisSettings(), out)
+    assert judged.verdict == "missing_physics" and judged.missing == []
+    assert judged.withheld == ["cubic_stiffness"] and judged.unexplained
+    assert "no library name: cubic_stiffness" in judged.headline
+    assert "the missing force: a force periodic in z" in judged.headline
+
+
+def test_a_force_within_its_uncertainty_checks_no_name():
+    """No missing force (the baseline at the truth): nothing to check a name against, so a
+    name is never withheld for it, and no shape claims a share of a force that is not
+    there."""
+    from harvester.diagnosis.shapes import has_its_shape
+    desc, share, _ = _named_beside(lambda z, v, t: 0.0 * z, "linear+cubic_stiffness",
+                                   [60.0, 1e6], "cubic_stiffness")
+    assert not desc.readable and has_its_shape(desc, ["cubic_stiffness"], share)
+    assert all(s.share < 0.5 for s in desc.shapes)
+
+
+def test_a_named_terms_own_force_is_sized_with_its_interval():
+    """relevance.term_force_rms: Coulomb friction of 6 N missing, the named term's posterior
+    F ~ N(6, 0.15) N: the 95 % interval of its own force's RMS holds the truth's RMS along
+    the true path (over the latent force's window), and tightens around a wrong level
+    (F ~ N(4, 0.15)) without holding it."""
+    from harvester.diagnosis.latent_views import parameter_values
+    from harvester.diagnosis.relevance import term_force_rms
+    from harvester.model.structures import structure
+    truth = rk4_record(lambda z, v, t: 6.0 * np.tanh(v / 1e-3), 12.0)
+    state = linear_state(recording(truth, "rel_acc"))
+    lf = latent_force(state, draws=40)
+    f_true = truth["f"][state.problem.window[0]:]
+    rms_true = float(np.sqrt(np.mean(f_true**2)))
+    rng = np.random.default_rng(0)
+    improved = structure("linear+coulomb_friction")
+    for level, holds in ((6.0, True), (4.0, False)):
+        samples = np.column_stack([np.full(200, 60.0), rng.normal(level, 0.15, 200)])
+        mid, lo, hi = term_force_rms(state.problem, improved, samples, "coulomb_friction")
+        assert lo < mid < hi and (lo <= rms_true <= hi) == holds, (lo, rms_true, hi)
+    assert parameter_values(improved, samples[0], {"M": 1.0})["F_coulomb"] == samples[0, 1]
+
+
+def test_a_term_whose_strength_trades_against_the_baseline_is_said_on_a_ridge():
+    """relevance.ridge: c_quad drawn along c_m + 0.02 c_quad = const (correlation about
+    -0.99) is on a ridge with c_m; drawn independently it is not."""
+    from harvester.diagnosis.relevance import ridge
+    from harvester.model.structures import structure
+    rng = np.random.default_rng(1)
+    improved = structure("linear+quadratic_damping")
+    c_quad = rng.normal(7.0, 1.0, 400)
+    along = np.column_stack([60.0 - 0.02 * c_quad + rng.normal(0, 0.002, 400), c_quad])
+    name, corr = ridge(improved, along, "quadratic_damping")
+    assert name == "c_m" and corr < -0.95
+    apart = np.column_stack([rng.normal(60.0, 0.02, 400), c_quad])
+    assert ridge(improved, apart, "quadratic_damping") is None
+
+
+def test_shapes_of_the_slow_part_do_not_judge_a_name_from_an_acceleration_record():
+    """shapes.slow_shapes: on a 6 Hz device recorded in z'', a shape fitted by a 0.3 Hz line
+    is slow and a 6 Hz one is not; from z nothing is slow (z sees a slow force). The name
+    check then skips the slow shape: a cubic spring explaining nothing is not withheld for
+    a slow line, and is for a fast one."""
+    from types import SimpleNamespace
+
+    from harvester.diagnosis.shapes import Shape, ShapeDescription, has_its_shape, slow_shapes
+    t = np.arange(0.0, 30.0, 1.0 / 256.0)
+    device = {"k": 14000.0, "M": 10.0}  # f_n = 5.96 Hz
+    slow = Shape("line", 0.4, {}, "", np.sin(2 * np.pi * 0.3 * t))
+    fast = Shape("periodic in z", 0.3, {}, "", np.sin(2 * np.pi * 6.0 * t))
+    acc = SimpleNamespace(output_kind="rel_acc", time=t, values=device)
+    assert slow_shapes(acc, [slow, fast]) == {"line"}
+    assert slow_shapes(SimpleNamespace(output_kind="rel_disp", time=t, values=device),
+                       [slow, fast]) == frozenset()
+    desc = ShapeDescription([slow, fast], 1.0, 0.1, "", slow=slow_shapes(acc, [slow, fast]))
+    assert not has_its_shape(desc, ["cubic_stiffness"], 0.0)  # periodic in z, 0.3
+    alone = ShapeDescription([slow], 1.0, 0.1, "", slow=frozenset({"line"}))
+    assert has_its_shape(alone, ["cubic_stiffness"], 0.0)

@@ -19,6 +19,7 @@ import numpy as np
 
 from harvester.diagnosis.baseline import ChainProblem
 from harvester.diagnosis.detect import Detection
+from harvester.inference.correlated_residuals import correlation_adjustment
 from harvester.inference.evidence import BridgeEstimate
 from harvester.inference.importance import ImportanceEstimate
 from harvester.inference.posterior import pooled_log_evidence
@@ -134,6 +135,18 @@ class ModelFit:
         if self.idata is None or "log_evidence_se" not in self.idata.sample_stats:
             return []
         return [float(x) for x in self.idata.sample_stats["log_evidence_se"].values]
+
+    def adjusted_samples(self) -> tuple[np.ndarray, bool]:
+        """(the samples with the physical parameters' draws adjusted for correlated
+        residuals, sigma's kept; whether they were): the sandwich covariance about the
+        posterior mean (``inference.correlated_residuals``), which the diagnosis's tempering
+        by lambda approximates; the samples as drawn where it cannot be formed (logged)."""
+        adj = correlation_adjustment(self.problem, self.samples, self.priors)
+        if adj is None:
+            return self.samples, False
+        out = np.array(self.samples, dtype=float)
+        out[:, :len(adj.names)] = adj.apply(out[:, :len(adj.names)])
+        return out, True
 
     def summary(self) -> dict[str, dict[str, float]]:
         return {n: {"mean": float(self.samples[:, j].mean()),

@@ -65,9 +65,12 @@ def latent_force_figure(lf: LatentForce, desc: ShapeDescription | None,
     return save_figure(fig, path, rect=(0, 0, 1, 0.96))
 
 
-def effect_force_figure(ef: EffectForce, path: str | Path, excerpt_s: float = 5.0) -> Path:
+def effect_force_figure(ef: EffectForce, path: str | Path, excerpt_s: float = 5.0,
+                        share: float | None = None) -> Path:
     """The named effect's force beside the latent force: an excerpt of both in time, and
-    both against z' and against z."""
+    both against z' and against z; titled with ``share`` (the share of the missing force it
+    explains as the shapes read theirs, ``ShapeDescription.share_of``; default its plain
+    share)."""
     fig, axes = plt.subplots(1, 3, figsize=(13, 4))
     t0 = ef.time[0]
     sel = ef.time <= t0 + excerpt_s
@@ -87,7 +90,8 @@ def effect_force_figure(ef: EffectForce, path: str | Path, excerpt_s: float = 5.
         ax.plot(x, ef.change, ".", color=MODEL, ms=1, label="improved - baseline")
         ax.set_xlabel(label)
         ax.set_ylabel(_force_label(ef.units, "force"))
-    fig.suptitle(f"{ef.term}: explains {100 * max(ef.share, 0):.0f} % of the latent force, "
+    share = ef.share if share is None else share
+    fig.suptitle(f"{ef.term}: explains {100 * max(share, 0):.0f} % of the latent force, "
                  f"{100 * ef.coverage:.0f} % of samples within its band", fontsize=TITLE_SIZE)
     return save_figure(fig, path, rect=(0, 0, 1, 0.93))
 
@@ -108,6 +112,7 @@ def all_latent_figures(lf: LatentForce, desc: ShapeDescription | None, out_dir: 
     """Write the figures to ``out_dir``; returns their file names."""
     out = Path(out_dir)
     files = [latent_force_figure(lf, desc, out / "latent_force.png").name]
-    files += [effect_force_figure(ef, out / f"latent_force_{ef.term}.png").name
+    files += [effect_force_figure(ef, out / f"latent_force_{ef.term}.png",
+                                  share=None if desc is None else desc.share_of(ef.change)).name
               for ef in effects]
     return files

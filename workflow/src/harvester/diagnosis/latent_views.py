@@ -105,7 +105,9 @@ class EffectForce:
                 "latent_rms_N": float(np.sqrt(np.mean(self.latent**2)))}
 
 
-def _values(structure: ModelStructure, theta: np.ndarray, known: Mapping[str, float]) -> dict:
+def parameter_values(structure: ModelStructure, theta: np.ndarray,
+                     known: Mapping[str, float]) -> dict:
+    """Every parameter's value: ``known`` with ``structure``'s free parameters at ``theta``."""
     values = dict(known)
     values.update(zip(structure.free_parameters, np.asarray(theta, dtype=float)))
     return values
@@ -117,7 +119,7 @@ def effect_force(lf: LatentForce, improved: ModelStructure, theta: np.ndarray,
     optional; ``known``: the rest) against the baseline along the latent force's joint draws
     of the states, averaged over them as f is, and the named term's own force (module
     docstring)."""
-    new = _values(improved, np.asarray(theta)[:len(improved.free_parameters)], known)
+    new = parameter_values(improved, np.asarray(theta)[:len(improved.free_parameters)], known)
     old = lf.values
     yb = lf.input if lf.input_kind == "base_acc" else np.zeros_like(lf.input)
     z, v, a = lf.state_draws if lf.state_draws.size else \

@@ -16,7 +16,7 @@ from harvester.diagnosis.baseline import BaselineState
 from harvester.diagnosis.latent import LatentForce, latent_force
 from harvester.diagnosis.latent_views import Binned, EffectForce, effect_force, views
 from harvester.diagnosis.relevance import (EffectSize, RelevanceFloor, effect_size,
-                                           response_change)
+                                           response_change, ridge, term_force_rms)
 from harvester.diagnosis.shapes import ShapeDescription, describe
 from harvester.model.structures import ModelStructure
 
@@ -24,11 +24,17 @@ from harvester.model.structures import ModelStructure
 @dataclass(frozen=True)
 class NamedEffect:
     """A term the diagnosis named and the improved model that holds it: its structure and
-    parameters (free parameters, sigma last optional)."""
+    parameters (free parameters, sigma last optional); and the posterior the term's own size
+    is read from (``sized``: its structure, by default ``structure``; ``samples``: rows of its
+    free parameters, sigma last optional; None: no size interval), with ``adjusted`` saying
+    whether those samples were adjusted for correlated residuals."""
 
     term: str
     structure: ModelStructure
     theta: np.ndarray
+    samples: np.ndarray | None = None
+    sized: ModelStructure | None = None
+    adjusted: bool = False
 
 
 @dataclass
@@ -71,8 +77,14 @@ def missing_force(state: BaselineState, window: tuple[int, int] | None = None,
             response = response_change(state.problem, state.theta, effect.structure,
                                        effect.theta, unseen_input,
                                        unseen_window or slice(None))
+        own, on_ridge = None, None
+        if effect.samples is not None:
+            sized = effect.sized or effect.structure
+            own = term_force_rms(state.problem, sized, effect.samples, effect.term)
+            on_ridge = ridge(sized, effect.samples, effect.term)
         out.effects.append(ef)
-        out.sizes.append(effect_size(lf, ef, floor, response))
+        out.sizes.append(effect_size(lf, ef, floor, response, desc.share_of(ef.change), own,
+                                     on_ridge, effect.adjusted))
     if out_dir is not None:
         from harvester.diagnosis.latent_figures import all_latent_figures
         out.figure_files = all_latent_figures(lf, desc, out_dir, out.effects)

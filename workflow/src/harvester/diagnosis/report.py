@@ -240,6 +240,7 @@ def _diagnosis_dict(d) -> dict:
         "fit_judgement": None if judged is None else judged.to_dict(s.floor_ratio),
         "missing_force": None if d.missing_force is None else d.missing_force.to_dict(),
         "missing": d.missing,
+        "withheld": d.withheld,
         "indistinguishable": d.indistinguishable,
         "ties": [tie.to_dict() for tie in d.ties],
         "unexplained_mismatch": d.unexplained,

@@ -82,6 +82,7 @@ class Diagnosis:
     headline: str = ""
     fit_judgement: FitJudgement | None = None
     missing_force: MissingForce | None = None
+    withheld: list[str] = field(default_factory=list)
 
     @property
     def indistinguishable(self) -> list[list[str]]:
@@ -148,7 +149,7 @@ def _diagnosis(a: Analysis, start: BaselineStart, rounds: list[Round],
         window_s=(float(t[a.lead]), float(t[a.hold - 1])),
         fit_window_s=(float(t[a.lead]), float(t[a.fit_stop - 1])), settings=settings,
         priors=start.priors, seconds=seconds, time=t, notes=notes, headline=found.headline,
-        fit_judgement=found.fit)
+        fit_judgement=found.fit, withheld=found.withheld)
 
 
 def fit_judgement(start: BaselineStart, first: Round, before: UnseenFit | None,
@@ -173,16 +174,14 @@ def estimate_missing_force(a: Analysis, state: BaselineState, found: Conclusion,
     record's or the held-out tail's); None with a note where it cannot be estimated."""
     if not settings.missing_force:
         return None, []
-    imp = found.improved_fit
-    named = [] if imp is None else [
-        NamedEffect(t, imp.structure, imp.samples.mean(axis=0))
-        for t in imp.structure.terms if t not in a.structure.terms]
+    named = named_effects(a.structure, found)
     rec, window = ((a.validation, slice(int(round(settings.lead_in_s / a.dt)), None))
                    if a.validation is not None else (a.recording, slice(a.hold, a.end)))
     clock = time.perf_counter()
     try:
         out = missing_force(state, (a.lead, a.hold), named, rec.iloc[:, 1].to_numpy(), window,
-                            RelevanceFloor(settings.relevance_share, settings.relevance_share,
+                            RelevanceFloor(settings.relevance_force_share,
+                                           settings.relevance_share,
                                            settings.relevance_share > 0),
                             units=settings.units)
     # a coupling term (backlash) has no force on the mass alone (term_forces); a model that
@@ -194,6 +193,28 @@ def estimate_missing_force(a: Analysis, state: BaselineState, found: Conclusion,
         return None, [f"missing force not estimated: {err}"]
     log.info("missing force: %s (%.1f s)", out.description.sentence, time.perf_counter() - clock)
     return out, []
+
+
+def named_effects(baseline: ModelStructure, found: Conclusion) -> list[NamedEffect]:
+    """Each term the improved model added, beside that model; its own size read from the fit
+    of the round that named it (``found.named_fit``; a later tie's model need not describe
+    it: a Duffing spring's k_cubic moved from 1.02e6 to 1.34e6 N/m^3 beside a tied inertia
+    error, truth 1.11e6), else from the improved model's, with the draws adjusted for
+    correlated residuals (``ModelFit.adjusted_samples``)."""
+    imp = found.improved_fit
+    if imp is None:
+        return []
+    adjusted = {}
+    out = []
+    for t in [t for t in imp.structure.terms if t not in baseline.terms]:
+        fit = found.named_fit if (found.named_fit is not None and t in found.missing
+                                  and t in found.named_fit.structure.terms) else imp
+        if id(fit) not in adjusted:
+            adjusted[id(fit)] = fit.adjusted_samples()
+        samples, done = adjusted[id(fit)]
+        out.append(NamedEffect(t, imp.structure, imp.samples.mean(axis=0), samples,
+                               fit.structure, done))
+    return out
 
 
 def unseen_comparison(a: Analysis, start: BaselineStart, improved: ModelFit | None,

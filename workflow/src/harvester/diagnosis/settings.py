@@ -25,9 +25,10 @@ class DiagnosisSettings:
     less of the unseen output than this share (1 - NRMSE^2) is "inadequate", unless its residual
     lies within ``floor_ratio`` of the recording's own noise floor (``floor.py``); floor_ratio:
     a residual RMS above this many times that floor is mismatch whatever the detection says;
-    relevance_share: a named effect whose force (share of the drive) and change of the unseen
-    response (share of the output) both lie below this share is "detectable but negligible",
-    not missing physics (``relevance.RelevanceFloor``; 0: off); missing_force: estimate the
+    relevance_share, relevance_force_share: a named effect whose change of the unseen
+    response (share of the output) lies below the first and whose force (share of the drive)
+    below the second is "detectable but negligible", not missing physics
+    (``relevance.RelevanceFloor``; relevance_share 0: off); missing_force: estimate the
     missing force of the baseline as a latent force, its shape and each named effect's size
     (``missing_force``);
     lead_in_s: start of the analysis (the model
@@ -64,6 +65,7 @@ class DiagnosisSettings:
     min_explained_share: float = 0.5
     floor_ratio: float = 3.0
     relevance_share: float = 0.01
+    relevance_force_share: float = 0.005
     missing_force: bool = True
     window_s: float = DetectionSettings.window_s
     lead_in_s: float = 1.0

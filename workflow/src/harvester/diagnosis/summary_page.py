@@ -71,6 +71,9 @@ def _missing_lines(doc: Mapping[str, Any]) -> list[str]:
     lines = [f"<b>{_esc(e)}</b>: {_esc((cands.get(e) or {}).get('implies', ''))}"
              + (f"<br>size: {_esc(sizes[e]['sentence'])}" if e in sizes else "")
              for e in doc.get("missing") or []]
+    if doc.get("withheld"):
+        lines.append("not named, their force lacks the missing force's shape: "
+                     + ", ".join(_esc(e) for e in doc["withheld"]))
     if (mf.get("shape") or {}).get("sentence"):
         lines.append(f"the missing force, seen without the library: "
                      f"{_esc(mf['shape']['sentence'])}")

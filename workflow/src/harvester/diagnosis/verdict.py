@@ -13,7 +13,9 @@ An effect is *named* only when it is accepted by evidence and every physically d
 candidate trails it by more than the acceptance threshold (``confirm.mark_ties``); otherwise
 the verdict lists the tie: what each candidate would mean physically, and which experiment
 would separate them with the expected evidence gap (``separate``). A wrong name misleads more
-than no name.
+than no name: the names (and ties) are withheld when the missing force, seen without the
+library, has a shape that the added terms do not (``withheld_names``); the verdict then says
+what the missing force looks like.
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ from harvester.diagnosis.floor import Floor
 from harvester.diagnosis.missing_force import MissingForce
 from harvester.diagnosis.rounds import Round
 from harvester.diagnosis.separate import Separation, separations
-from harvester.diagnosis.shapes import beyond_uncertainty
+from harvester.diagnosis.shapes import beyond_uncertainty, has_its_shape, library_terms
 from harvester.diagnosis.settings import DiagnosisSettings
 
 log = logging.getLogger("harvester.diagnosis")
@@ -171,6 +173,7 @@ class Conclusion:
     fit: FitJudgement | None = None
     headline: str = ""
     named_fit: ModelFit | None = None
+    withheld: list[str] = field(default_factory=list)
 
 
 def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings,
@@ -199,6 +202,27 @@ def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings
                       named_fit=named[-1] if named else None)
 
 
+def withheld_names(found: Conclusion, missing: MissingForce | None) -> str | None:
+    """Why the effects named and tied are withheld, or None: they are relevant, the missing
+    force can be read, and the added terms' force together lacks its shape
+    (``shapes.has_its_shape``): the frame's hysteresis, the best shape friction, keeps its
+    name; a Stribeck friction and a mode whose force explains 1.5 % of a friction level
+    drifting in time (14.5 %, the literature generator's friction drift) do not."""
+    sizes = [] if missing is None else [s for s in missing.sizes if not s.negligible]
+    if not sizes or not (found.missing or found.ties):
+        return None
+    desc, share = missing.description, sizes[0].explains
+    if has_its_shape(desc, [s.term for s in sizes], share):
+        return None
+    terms = library_terms(desc.best.name)
+    has = (f" (the library's {' / '.join(terms)}, of this shape, was not accepted by evidence)"
+           if terms else " (outside the library)")
+    return (f"{' + '.join(s.term for s in sizes)} accepted by evidence, but their force "
+            f"explains {100 * share:.0f} % of the missing force against "
+            f"{100 * desc.best.share:.0f} % for {desc.best.name}{has}, a shape none of them "
+            "has: not named")
+
+
 def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
           settings: DiagnosisSettings, missing: MissingForce | None = None) -> Conclusion:
     """The verdict with the fit on unseen data, the noise floor and the named effects'
@@ -216,6 +240,12 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
                              above_floor=above, within_floor=within)
     notes, unexplained = list(found.notes), found.unexplained
     notes += [f"detectable but negligible: {s.sentence()}" for s in sizes if s.negligible]
+    why = withheld_names(found, missing)
+    if why is not None:
+        notes.append(why)
+        unexplained = True
+        found = replace(found, missing=[], ties=[],
+                        withheld=found.missing + [e for t in found.ties for e in t.effects])
     if above and not found.accepted:
         unexplained = True
         notes.append(f"the residual is {fit.ratio:.3g} x the recording's noise floor "
@@ -300,13 +330,16 @@ def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
         # accepted effects below the relevance floor leave the verdict adequate
         label = "missing" if verdict != "adequate" else "detectable but negligible"
         parts.append(f"{label}: " + _named(found, missing, units))
+    if found.withheld:
+        parts.append(f"no library name: {', '.join(found.withheld)} lack the missing force's "
+                     "shape")
     share = fit.library_share()
     if verdict != "adequate":
         parts.append(_library_phrase(share, found.accepted))
         if not found.accepted and latent_unread(missing, fit, limit):
             parts.append("the missing force: not readable by the smoother (its noise took the "
                          "whole residual)")
-        elif not found.accepted and missing is not None:
+        elif (not found.accepted or found.withheld) and missing is not None:
             parts.append(f"the missing force: {missing.description.sentence}")
     return "; ".join(parts)
 

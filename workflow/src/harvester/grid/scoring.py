@@ -15,6 +15,15 @@ something false), ``missed`` (adequate, or a mismatch without a name or tie). Al
 "inadequate").
 On an effect-free scenario, a false alarm is a flagged verdict.
 
+Size (``named_size``). Where the truth gives the force the nominal device misses along the
+true path (``missing_force_rms_N``, the literature generator's), the first term named alone
+is checked against it: the RMS of its own force over its posterior, each sample along its
+own simulated path (median and 95 % interval; ``diagnosis.relevance.term_force_rms``), and
+whether that interval holds the truth. The two are one quantity for an effect added to the
+device (a stop, a spring, a damper, a mass error); for a friction law with memory the truth
+is the law's departure from the sliding one, which a term beside a refitted sliding law need
+not equal.
+
 Rates carry Wilson score intervals (95 %). The goals of the issue: named correctly in at least
 90 % of seeds at a contribution of half the noise RMS, and at most 5 % false alarms.
 
@@ -210,7 +219,29 @@ def score(truth: Mapping[str, Any], diagnosis: Mapping[str, Any],
         # the detection screen alone (before any evidence), at its own alpha
         "screen_flagged": bool(p_value < float(screen.get("alpha", 0.05))),
         "runtime_s": float(diagnosis.get("runtime_s", np.nan)),
+        **named_size(truth, diagnosis),
     }
+
+
+def named_size(truth: Mapping[str, Any], diagnosis: Mapping[str, Any]) -> dict[str, float]:
+    """The first named term's own force RMS (N: median, 95 % interval) beside the truth's
+    missing force RMS, whether the interval holds it (1.0 / 0.0; NaN where either is not
+    given: nothing named alone, a diagnosis without sizes, a generator without the truth),
+    and the baseline parameter its strength lies on a ridge with ("" for none)."""
+    true = (truth.get("literature") or truth).get("missing_force_rms_N")
+    missing = list(diagnosis.get("missing") or [])
+    sizes = {e.get("term"): e for e in
+             ((diagnosis.get("missing_force") or {}).get("named_effects") or [])}
+    size = sizes.get(missing[0]) if missing else None
+    nan = float("nan")
+    if size is None or size.get("term_force_rms_interval_N") is None:
+        return {"size_true_N": nan if true is None else float(true), "size_N": nan,
+                "size_lo_N": nan, "size_hi_N": nan, "size_covered": nan, "size_ridge": ""}
+    lo, hi = (float(x) for x in size["term_force_rms_interval_N"])
+    return {"size_true_N": nan if true is None else float(true),
+            "size_N": float(size["term_force_rms_N"]), "size_lo_N": lo, "size_hi_N": hi,
+            "size_covered": nan if true is None else float(lo <= float(true) <= hi),
+            "size_ridge": (size.get("ridge") or {}).get("parameter", "")}
 
 
 def _tie_label(diagnosis: Mapping[str, Any]) -> str:
@@ -235,6 +266,8 @@ def detection_table(results: pd.DataFrame, goal_ratio: float = GOAL_RATIO,
     ``meets_goal`` (at ``goal_ratio`` only): the rate reaches ``goal_rate``; ``goal_certain``:
     the interval's lower end does. ``nameable``: seeds whose information reaches the acceptance
     threshold (module docstring), ``named_nameable`` how many of them were named first.
+    ``sized``: seeds named alone with a size and a truth (``named_size``),
+    ``size_covered_rate`` the share of them whose 95 % interval holds the truth.
     """
     res = results[~results["effect_free"]]
     rows = []
@@ -256,6 +289,9 @@ def detection_table(results: pd.DataFrame, goal_ratio: float = GOAL_RATIO,
             "named_nameable": int((g["named"] & g["nameable"]).sum()),
             "invisible_share": float(g["invisible"].mean()),
             "most_named_instead": _most_common(g.loc[~g["named"], "named_effect"]),
+            # named alone with a size and a truth to hold it against (``named_size``)
+            "sized": int(g["size_covered"].notna().sum()),
+            "size_covered_rate": float(g["size_covered"].mean()),
             "meets_goal": (k / n >= goal_rate) if at_goal else None,
             "goal_certain": (float(lo) >= goal_rate) if at_goal else None,
         })
