@@ -60,6 +60,16 @@ def test_sections_without_figures_are_left_out(tmp_path):
     assert "<h2>The candidates</h2><table>" in page  # the table stands without its figure
 
 
+def test_withheld_names_are_said_beside_the_missing_force(tmp_path):
+    """A diagnosis whose names were withheld (``verdict.withheld_names``) lists them as not
+    named, with the missing force's description, and no "no library effect named"."""
+    doc = {**DOC, "missing": [], "ties": [], "withheld": ["stribeck_friction"],
+           "missing_force": {"shape": {"sentence": "a friction drifting in time"}}}
+    page = summary_page(doc, tmp_path, "t")
+    assert "not named, their force lacks the missing force's shape: stribeck_friction" in page
+    assert "a friction drifting in time" in page and "no library effect named" not in page
+
+
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 
 
