@@ -108,11 +108,13 @@ def _wrap(text: str, width: int = 110) -> str:
 
 
 def all_latent_figures(lf: LatentForce, desc: ShapeDescription | None, out_dir: str | Path,
-                       effects: list[EffectForce] = ()) -> list[str]:
-    """Write the figures to ``out_dir``; returns their file names."""
+                       effects: list[EffectForce] = (), shares: list[float] | None = None
+                       ) -> list[str]:
+    """Write the figures to ``out_dir``; returns their file names. ``shares``: each effect's
+    share of the missing force as the shapes read theirs (``EffectSize.explains``)."""
     out = Path(out_dir)
     files = [latent_force_figure(lf, desc, out / "latent_force.png").name]
     files += [effect_force_figure(ef, out / f"latent_force_{ef.term}.png",
-                                  share=None if desc is None else desc.share_of(ef.change)).name
-              for ef in effects]
+                                  share=None if shares is None else shares[i]).name
+              for i, ef in enumerate(effects)]
     return files

@@ -87,5 +87,6 @@ def missing_force(state: BaselineState, window: tuple[int, int] | None = None,
                                      on_ridge, effect.adjusted))
     if out_dir is not None:
         from harvester.diagnosis.latent_figures import all_latent_figures
-        out.figure_files = all_latent_figures(lf, desc, out_dir, out.effects)
+        out.figure_files = all_latent_figures(lf, desc, out_dir, out.effects,
+                                              [s.explains for s in out.sizes])
     return out

@@ -288,7 +288,8 @@ def write(diag: Diagnosis, out_dir: str | Path, title: str | None = None) -> Pat
         if diag.missing_force is not None:
             from harvester.diagnosis.latent_figures import all_latent_figures
             mf = diag.missing_force
-            mf.figure_files = all_latent_figures(mf.latent, mf.description, out, mf.effects)
+            mf.figure_files = all_latent_figures(mf.latent, mf.description, out, mf.effects,
+                                                 [s.explains for s in mf.sizes])
             diag.figure_files.extend(mf.figure_files)
     path = out / "diagnosis.json"
     doc = diag.to_dict()

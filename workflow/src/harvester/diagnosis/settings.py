@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from harvester.data.units import SI, Units, read_units
 from harvester.diagnosis.confirm import ConfirmSettings
 from harvester.diagnosis.detect import DetectionSettings
+from harvester.diagnosis.relevance import RelevanceFloor
 
 
 @dataclass(frozen=True)
@@ -64,8 +65,8 @@ class DiagnosisSettings:
     unexplained_alpha: float = 0.001
     min_explained_share: float = 0.5
     floor_ratio: float = 3.0
-    relevance_share: float = 0.01
-    relevance_force_share: float = 0.005
+    relevance_share: float = RelevanceFloor.response_share
+    relevance_force_share: float = RelevanceFloor.force_share
     missing_force: bool = True
     window_s: float = DetectionSettings.window_s
     lead_in_s: float = 1.0
