@@ -205,6 +205,12 @@ class OutputKind:
     def motion_symbol(self) -> str:
         return "z''" if self.order == 2 else "z'"
 
+    @property
+    def holds_slow_motion(self) -> bool:
+        """Whether this kind fixes the slow part of z: a displacement does; from z'' a slow
+        force trades against k z, its effect on z'' falling as (f / f_n)^2 below f_n."""
+        return self.order == 0
+
     def velocity(self, x: ArrayLike, dt: float, lowpass_hz: float | None) -> NDArray:
         """z' from this kind's values (:func:`derivative`: a displacement differentiated, an
         acceleration integrated above 0.1 Hz, up to a slow drift: for levels and power

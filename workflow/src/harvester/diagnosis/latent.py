@@ -19,12 +19,31 @@ filtering, backward sampling), which carries the states' uncertainty into f.
 Band. The recording holds the motion only inside the measurement chain's band (the
 likelihood's low-pass, ``ChainProblem.band_hz``), so the force is estimated inside it: the
 drive and the recorded output go through that low-pass, and the force (each draw) too. The
-output is measured every ``stride`` samples, fs / (2 band) (8 at 256 Hz for a 20 Hz
-recording), where the band-limited noise is close to independent.
+noise went through the low-pass as well: white before it, band-limited and correlated over
+the filter's memory after it. Two ways to measure it:
+
+* the noise's level given (the recording's own floor, ``floor.py``, as the diagnosis does)
+  on a displacement record: the band-limited noise is a state space of its own
+  (``state_space.filtered_noise``: the zero-phase filter's spectrum, run causally), and
+  every sample is measured without its correlated noise being counted as independent; what
+  the stop band holds beyond the filter's response is a floor of FLOOR_SHARE x the
+  baseline's sigma. Every 12th sample of the frame's displacement (an 8 Hz band at 143 Hz)
+  was too few to see its friction (docs/latent-force.md).
+* otherwise the output is measured every ``stride`` samples, fs / (2 band) (8 at 256 Hz for
+  a 20 Hz recording), where the band-limited noise is close to independent, as white noise.
+  With its level free, band-limited noise explains a mismatch whose spectrum is as flat as a
+  sign law's as well as a force does (a 6 N Coulomb friction missing from a 12 s z''
+  record: the noise at the baseline's sigma scored 4000 nats above the force with the noise
+  at the sensor's level); and from z'' (``OutputKind.holds_slow_motion``) every sample
+  measured let the slow part the record leaves open grow (a cubic spring's 1.37 N: 2.57 N
+  of error, 2.51 N of it below 1 Hz, against 0.59 N at the stride).
 
 Hyperparameters. The process's length scale and sd, and the noise sd, maximise the Kalman
 filter's marginal likelihood; the noise sd is bounded above by the baseline's sigma, which
-holds the mismatch as well as the noise (``noise='baseline'`` fixes it there instead).
+holds the mismatch as well as the noise (``noise='baseline'`` fixes it there instead; a
+value fixes it there: the diagnosis gives the recording's own noise floor, measured where
+the model has no say, ``floor.py``, so that what the baseline leaves beyond the noise is
+force).
 The baseline's parameters are held at their posterior mean (their uncertainty is not
 carried).
 """
@@ -36,14 +55,14 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import optimize
+from scipy import linalg, optimize
 
-from harvester.data.signals import lowpass
+from harvester.data.signals import butterworth_sos, lowpass
 from harvester.data.units import SI, Units
 from harvester.diagnosis.baseline import BaselineState
-from harvester.diagnosis.state_space import (MATERN_STATES, backward_sample, discretise,
-                                             kalman_filter, kalman_loglik, matern,
-                                             rts_smoother)
+from harvester.diagnosis.state_space import (MATERN_STATES, Discrete, backward_sample,
+                                             discretise, filtered_noise, kalman_filter,
+                                             kalman_loglik, matern, rts_smoother)
 from harvester.diagnosis.term_forces import term_forces
 
 log = logging.getLogger("harvester.diagnosis")
@@ -52,6 +71,9 @@ log = logging.getLogger("harvester.diagnosis")
 LENGTH_STARTS_S = (0.02, 0.08, 0.3, 1.0)
 #: Draws of the state path that carry the uncertainty into f.
 PATH_DRAWS = 100
+#: What the recording holds beyond its chain's response (its stop band), as a share of the
+#: baseline's sigma: the measurement noise that is not band-limited (rounding, leakage).
+FLOOR_SHARE = 1e-3
 
 
 @dataclass
@@ -79,12 +101,17 @@ class LatentForce:
     baseline_noise_sd: float
     log_marginal: float  # nats
     band_hz: float
-    stride: int
+    stride: int  # samples between the outputs measured
     seconds: float
     filter_order: int = 8  # the band's zero-phase Butterworth low-pass
+    noise_in_band: bool = False  # the noise modelled as band-limited (module docstring)
     draws: np.ndarray = field(repr=False, default_factory=lambda: np.empty((0, 0)))
     #: joint draws of (z, z', z'') along the window, (3, draws, samples), SI units
     state_draws: np.ndarray = field(repr=False, default_factory=lambda: np.empty((3, 0, 0)))
+    #: the same draws over the record before the window, and the input there: a term's own
+    #: states (hysteresis, a mode) settle along them before the window starts
+    lead_draws: np.ndarray = field(repr=False, default_factory=lambda: np.empty((3, 0, 0)))
+    lead_input: np.ndarray = field(repr=False, default_factory=lambda: np.empty(0))
     #: the recording's units (``data.units``): "N" and "m" above stand for them
     units: Units = SI
 
@@ -119,7 +146,8 @@ class LatentForce:
                 "kernel": self.kernel, "length_scale_s": self.length_scale_s,
                 "amplitude_N": self.amplitude_N, "noise_sd": self.noise_sd,
                 "baseline_noise_sd": self.baseline_noise_sd, "log_marginal": self.log_marginal,
-                "band_hz": self.band_hz, "stride": self.stride, "seconds": self.seconds,
+                "band_hz": self.band_hz, "stride": self.stride,
+                "noise_in_band": self.noise_in_band, "seconds": self.seconds,
                 "force_unit": self.units.label("force")}
 
 
@@ -133,12 +161,14 @@ class _Device:
     base: np.ndarray  # y'' in the band (zeros for a force input)
     input: np.ndarray
     y: np.ndarray
-    measured: np.ndarray
     kind: str
     z_scale: float
     v_scale: float
-    stride: int
+    #: the chain's noise (``state_space.filtered_noise``: A, c, P), None: white noise
+    noise: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+    stride: int = 1  # samples between measurements
     initial_sd: float = 0.01  # prior sd of (z, z') at the first sample / their RMS
+    floor: float = 0.0  # sd of the noise beyond the chain's response (output's unit)
 
     @property
     def M(self) -> float:
@@ -152,7 +182,7 @@ class _Device:
         return np.array([-k / M, -c / M, -1.0 / M]), 1.0 / M
 
 
-def _device(state: BaselineState, stop: int, stride: int) -> tuple[_Device, np.ndarray]:
+def _device(state: BaselineState, stop: int) -> tuple[_Device, np.ndarray]:
     """The baseline's linear part, drive and measurement, and its residual in the output's
     kind (both through the chain) over the record's first ``stop`` samples."""
     p = state.problem
@@ -163,15 +193,13 @@ def _device(state: BaselineState, stop: int, stride: int) -> tuple[_Device, np.n
     force_input = p.input_kind == "force"
     drive = u if force_input else -values["m"] * u
     y = p.measured_chain[:stop]
-    measured = np.zeros(stop, dtype=bool)
-    measured[::stride] = True
     sim = p.simulate(theta)
     if not sim.ok[0]:
         raise RuntimeError(f"the baseline {p.structure.name} cannot be simulated at theta")
     out = sim.rel_disp[0] if p.output_kind == "rel_disp" else sim.rel_acc[0]
     scale = lambda x: float(max(np.sqrt(np.mean(np.square(x[:stop]))), 1e-9))  # noqa: E731
-    dev = _Device(values, p.dt, drive, np.zeros(stop) if force_input else u, u, y, measured,
-                  p.output_kind, scale(sim.rel_disp[0]), scale(sim.rel_vel[0]), stride)
+    dev = _Device(values, p.dt, drive, np.zeros(stop) if force_input else u, u, y,
+                  p.output_kind, scale(sim.rel_disp[0]), scale(sim.rel_vel[0]))
     return dev, y - p.chain(out)[:stop]
 
 
@@ -181,8 +209,9 @@ INITIAL_SD = 0.01
 
 
 def _model(dev: _Device, kernel: str, length: float, amp: float, noise: float):
-    """The augmented model in scaled states (z / z_s, z' / v_s, g^(j) / (amp lam^j)):
-    (discrete model, H, D, R, initial mean and covariance, scales)."""
+    """The augmented model in scaled states (z / z_s, z' / v_s, g^(j) / (amp lam^j), and the
+    chain's noise states in units of its white input): (discrete model, H, D, R, initial
+    mean and covariance, scales)."""
     F, q, P_inf = matern(kernel, length, amp)
     p = len(F)
     n = 2 + p
@@ -205,13 +234,32 @@ def _model(dev: _Device, kernel: str, length: float, amp: float, noise: float):
     P0 = np.zeros((n, n))
     P0[:2, :2] = np.diag([dev.initial_sd**2] * 2)
     P0[2:, 2:] = P_inf * np.outer(Ti[2:], Ti[2:])
-    return disc, H, D, noise**2, np.zeros(n), P0, T
+    if dev.noise is None:
+        return disc, H, D, noise**2, np.zeros(n), P0, T
+    return _with_chain_noise(disc, H, D, P0, T, dev, noise)
+
+
+def _with_chain_noise(disc: Discrete, H, D, P0, T, dev: _Device, noise: float):
+    """The model with the chain's band-limited noise of sd ``noise`` (output's unit) as
+    states (``state_space.filtered_noise``), measured through them; the white floor beyond
+    the chain's response left as the measurement noise."""
+    An, cn, Pn = dev.noise
+    m = len(An)
+    Q = np.zeros((m, m))
+    Q[-1, -1] = 1.0
+    aug = Discrete(linalg.block_diag(disc.Phi, An), np.concatenate([disc.G0, np.zeros(m)]),
+                   np.concatenate([disc.G1, np.zeros(m)]), linalg.block_diag(disc.Q, Q))
+    n = len(H) + m
+    return (aug, np.concatenate([H, noise * cn]), D, max(dev.floor, 1e-300) ** 2, np.zeros(n),
+            linalg.block_diag(P0, Pn), np.concatenate([T, np.ones(m)]))
 
 
 def _filter(dev: _Device, kernel: str, length: float, amp: float, noise: float):
     disc, H, D, R, m0, P0, T = _model(dev, kernel, length, amp, noise)
+    measured = np.zeros(len(dev.y), dtype=bool)
+    measured[::dev.stride] = True
     out = kalman_filter(disc.Phi, disc.G0, disc.G1, disc.Q, H, D, R, dev.drive, dev.y,
-                        dev.measured, m0, P0)
+                        measured, m0, P0)
     return out, disc, T
 
 
@@ -245,11 +293,23 @@ def fit_hyperparameters(dev: _Device, kernel: str, amp0: float, noise_max: float
 
 
 def measurement_stride(state: BaselineState) -> int:
-    """Samples between the outputs the smoother measures: fs / (2 x the chain's band), where
-    the band-limited noise is close to independent (1 without a band below Nyquist)."""
+    """Samples between the outputs the smoother measures with white noise: fs / (2 x the
+    chain's band), where the band-limited noise is close to independent (1 without a band
+    below Nyquist)."""
     p = state.problem
     band = getattr(p, "band_hz", None)
     return 1 if band is None else max(1, int(np.floor(0.5 / (p.dt * band))))
+
+
+def chain_noise(state: BaselineState) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The measurement chain's noise as a state space (``state_space.filtered_noise`` of the
+    likelihood's zero-phase low-pass), None where the chain has no band below Nyquist."""
+    p = state.problem
+    band = getattr(p, "band_hz", None)
+    if band is None or not np.isfinite(band) or band >= 0.5 / p.dt:
+        return None
+    return filtered_noise(butterworth_sos(1.0 / p.dt, float(band),
+                                          int(getattr(p, "filter_order", 8))))
 
 
 def _force_scale(dev: _Device, residual: np.ndarray) -> float:
@@ -299,30 +359,41 @@ def _forces(state: BaselineState, dev: _Device, mean: np.ndarray, paths: np.ndar
 
 def latent_force(state: BaselineState, window: tuple[int, int] | None = None, *,
                  kernel: str = "matern52", noise: str | float = "fit",
-                 draws: int = PATH_DRAWS, seed: int = 0,
+                 noise_floor: float | None = None, draws: int = PATH_DRAWS, seed: int = 0,
                  initial_sd: float = INITIAL_SD, units: Units = SI) -> LatentForce:
     """The missing force of the baseline ``state`` over ``window`` (samples; the problem's
     by default), module docstring. ``kernel``: 'matern32' or 'matern52'; ``noise``: 'fit'
-    (marginal likelihood, at most the baseline's sigma), 'baseline' (its sigma) or a value in
-    the output's unit (an independent noise floor); ``draws``: joint draws of the state path
+    (marginal likelihood, at most the baseline's sigma; white, every ``stride`` samples),
+    'baseline' (its sigma) or a value in the output's unit; a given level is modelled
+    band-limited, every sample measured, on a record that fixes the slow motion;
+    ``noise_floor``:
+    the recording's own noise floor (output's unit, ``floor.py``), taken as the noise's level
+    on such a record and ignored on others (``noise`` then); ``draws``: joint draws of the state path
     behind the sd; ``initial_sd``: :data:`INITIAL_SD`; ``units``: the recording's (labels)."""
     if kernel not in MATERN_STATES:
         raise ValueError(f"kernel must be one of {sorted(MATERN_STATES)}, got {kernel!r}")
     clock = time.perf_counter()
     p = state.problem
     start, stop = window or p.window
-    dev, residual = _device(state, stop, measurement_stride(state))
+    dev, residual = _device(state, stop)
     dev.initial_sd = float(initial_sd)
     sigma_b = float(state.theta[-1])
     fixed = None if noise == "fit" else (sigma_b if noise == "baseline" else float(noise))
+    if noise_floor is not None and p.output_type.holds_slow_motion:
+        fixed = min(float(noise_floor), sigma_b)
+    if fixed is not None and p.output_type.holds_slow_motion:
+        dev.noise, dev.floor = chain_noise(state), FLOOR_SHARE * sigma_b
+    else:
+        dev.stride = measurement_stride(state)
     length, amp, noise_sd, logml = fit_hyperparameters(
         dev, kernel, _force_scale(dev, residual[start:stop]), fixed or sigma_b, fixed is None)
     filtered, disc, T = _filter(dev, kernel, length, amp, noise_sd)
     mean, paths = _paths(dev, disc, T, filtered, draws, seed)
     force, f_paths, terms_mean = _forces(state, dev, mean, paths)
     w = slice(start, stop)
-    z, v, g = paths[:, w, 0], paths[:, w, 1], paths[:, w, 2]
-    acc_draws = (dev.drive[w] - dev.values["c_m"] * v - dev.values["k"] * z - g) / dev.M
+    z, v, g = paths[..., 0], paths[..., 1], paths[..., 2]
+    states = np.stack([z, v, _acceleration(dev, z, v, g)])
+    z = z[:, w]
     out = LatentForce(
         time=np.arange(stop)[w] * p.dt, force=force[w], sd=f_paths.std(axis=0)[w],
         rel_disp=mean[w, 0], disp_sd=z.std(axis=0), rel_vel=mean[w, 1],
@@ -331,8 +402,10 @@ def latent_force(state: BaselineState, window: tuple[int, int] | None = None, *,
         values=dev.values, input_kind=p.input_kind, output_kind=p.output_kind, kernel=kernel,
         length_scale_s=length, amplitude_N=amp, noise_sd=noise_sd, baseline_noise_sd=sigma_b,
         log_marginal=logml, band_hz=float(getattr(p, "band_hz", np.nan)), stride=dev.stride,
+        noise_in_band=dev.noise is not None,
         seconds=time.perf_counter() - clock, filter_order=int(getattr(p, "filter_order", 8)),
-        draws=f_paths[:, w], state_draws=np.stack([z, v, acc_draws]), units=units)
+        draws=f_paths[:, w], state_draws=states[..., w], lead_draws=states[..., :start],
+        lead_input=dev.input[:start], units=units)
     unit = units.label("force")
     log.info("latent force of %s: RMS %.3g %s (sd %.2g %s), length scale %.3g s, noise %.3g "
              "(baseline's sigma %.3g), %.1f s", p.structure.name, out.rms_N, unit,

@@ -121,20 +121,33 @@ def effect_force(lf: LatentForce, improved: ModelStructure, theta: np.ndarray,
     docstring)."""
     new = parameter_values(improved, np.asarray(theta)[:len(improved.free_parameters)], known)
     old = lf.values
-    yb = lf.input if lf.input_kind == "base_acc" else np.zeros_like(lf.input)
-    z, v, a = lf.state_draws if lf.state_draws.size else \
-        (x[None, :] for x in (lf.rel_disp, lf.rel_vel, lf.rel_acc))
+    z, v, a, u, lead = _states_from_start(lf)
+    yb = u if lf.input_kind == "base_acc" else np.zeros_like(u)
     states = (z, v, a, yb, float(lf.time[1] - lf.time[0]))
     change = (model_force(improved.layout, new, *states)
               - model_force(_layout_of(lf), old, *states)
               + (new["M"] - old["M"]) * a + (new["m"] - old["m"]) * yb[None, :])
-    change = lf.band(change).mean(axis=0)
-    own = lf.band(term_force(term(term_name), new, *states)).mean(axis=0)
+    change = lf.band(change)[:, lead:].mean(axis=0)
+    own = lf.band(term_force(term(term_name), new, *states))[:, lead:].mean(axis=0)
     f = lf.force
     share = 1.0 - float(np.sum((f - change) ** 2) / max(np.sum(f**2), 1e-300))
     coverage = float(np.mean(np.abs(f - change) < 2.0 * lf.sd))
     return EffectForce(term_name, lf.time, f, lf.sd, change, own, share, coverage,
                        float(np.sqrt(np.mean(change**2))), lf.rel_disp, lf.rel_vel, lf.units)
+
+
+def _states_from_start(lf: LatentForce):
+    """(z, z', z'' (draws, samples), the input, the samples before the window) from the
+    record's start, so that a term's own states settle before the window (``lead_draws``);
+    the smoothed means alone where no draws were kept."""
+    if not lf.state_draws.size:
+        z, v, a = (x[None, :] for x in (lf.rel_disp, lf.rel_vel, lf.rel_acc))
+        return z, v, a, lf.input, 0
+    lead = lf.lead_draws.shape[-1]
+    if lead == 0 or lf.lead_draws.shape[1] != lf.state_draws.shape[1]:
+        return (*lf.state_draws, lf.input, 0)
+    z, v, a = np.concatenate([lf.lead_draws, lf.state_draws], axis=-1)
+    return z, v, a, np.concatenate([lf.lead_input, lf.input]), lead
 
 
 def _layout_of(lf: LatentForce) -> Layout:

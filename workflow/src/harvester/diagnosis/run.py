@@ -33,7 +33,7 @@ from harvester.diagnosis.rounds import Round, run_rounds
 from harvester.diagnosis.settings import DiagnosisSettings
 from harvester.diagnosis.signatures import candidate_terms
 from harvester.diagnosis.spectral import filter_cutoff
-from harvester.diagnosis.floor import output_floor
+from harvester.diagnosis.floor import Floor, output_floor
 from harvester.diagnosis.missing_force import MissingForce, NamedEffect, missing_force
 from harvester.diagnosis.relevance import RelevanceFloor
 from harvester.diagnosis.verdict import (Conclusion, FitJudgement, Tie, conclude,
@@ -116,9 +116,10 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
     found = conclude(rounds, unexplained, settings, analysis.f_high)
     before, after, unseen_notes = unseen_comparison(analysis, start, found.improved_fit,
                                                     settings)
-    missing, missing_notes = estimate_missing_force(analysis, rounds[0].state, found, settings)
-    found = judge(found, rounds[0].detection, fit_judgement(start, rounds[0], before, after),
-                  analysis.structure.name, settings, missing)
+    fit = fit_judgement(start, rounds[0], before, after)
+    missing, missing_notes = estimate_missing_force(analysis, rounds[0].state, found, settings,
+                                                    fit.floor)
+    found = judge(found, rounds[0].detection, fit, analysis.structure.name, settings, missing)
     unseen_notes += missing_notes
     diag = _diagnosis(analysis, start, rounds, baseline_fit, found, (before, after), settings,
                       analysis.notes + notes + found.notes + unseen_notes,
@@ -168,10 +169,14 @@ def fit_judgement(start: BaselineStart, first: Round, before: UnseenFit | None,
 
 
 def estimate_missing_force(a: Analysis, state: BaselineState, found: Conclusion,
-                           settings: DiagnosisSettings) -> tuple[MissingForce | None, list[str]]:
+                           settings: DiagnosisSettings, floor: Floor | None = None
+                           ) -> tuple[MissingForce | None, list[str]]:
     """The baseline's missing force (``missing_force``) over the analysed window, with each
     effect the improved model added beside it and its size on the unseen input (the validation
-    record's or the held-out tail's); None with a note where it cannot be estimated."""
+    record's or the held-out tail's); None with a note where it cannot be estimated. On a
+    record that fixes the slow motion (a displacement) the smoother's noise is the
+    recording's own ``floor`` where it shows one (``floor.py``; at most the baseline's
+    sigma), so that what the baseline leaves beyond the noise is force (``latent``)."""
     if not settings.missing_force:
         return None, []
     named = named_effects(a.structure, found)
@@ -183,7 +188,8 @@ def estimate_missing_force(a: Analysis, state: BaselineState, found: Conclusion,
                             RelevanceFloor(settings.relevance_force_share,
                                            settings.relevance_share,
                                            settings.relevance_share > 0),
-                            units=settings.units)
+                            units=settings.units,
+                            noise_floor=None if floor is None else floor.rms)
     # a coupling term (backlash) has no force on the mass alone (term_forces); a model that
     # cannot be simulated at its posterior mean or on the unseen input (latent, relevance);
     # a smoother whose covariance is not positive definite: each leaves the diagnosis without
