@@ -128,8 +128,9 @@ def _frame_state(load: str, fit_damping: bool = False):
 @pytest.mark.skipif(not FRAME.is_dir(), reason="the frame's recordings are not beside the clone")
 def test_the_frames_friction_sticks_and_slides_at_a_level_rising_with_the_load():
     """Real recordings: the linear baseline's missing force is stick and slip of a contact on
-    the ground (99-100 % explained), sliding at 0.67 N (250 g) and 1.27 N (450 g): a friction
-    coefficient of about 0.28 at both loads (measured)."""
+    the ground (98-99 % explained; stuck 47 % and 51 % of the time), sliding at 0.65 N
+    (250 g) and 1.24 N (450 g) with the law's held force (gain 0.94, 0.98): a friction
+    coefficient of 0.27 and 0.28 (measured)."""
     level = {}
     for load in ("250", "450"):
         desc = describe(latent_force(_frame_state(load), draws=40, initial_sd=1.0))
@@ -144,11 +145,12 @@ def test_the_frames_friction_sticks_and_slides_at_a_level_rising_with_the_load()
 def test_the_frames_friction_is_seen_beyond_its_noise_floor_under_a_fitted_baseline():
     """Real recordings, the diagnosis's way: the linear baseline's c_m fitted (it takes the
     friction's equivalent damping), the noise at the recording's own floor (repeated
-    periods), band-limited and measured at every sample. The missing force is a friction on
-    the ground (its equivalent damping taken back), beyond its bands, rising with the load:
-    measured 1.32 N RMS at 250 g, 2.63 N at 450 g (1.06 N and 1.81 N sliding). On this
-    conversion (a 16 Hz band at 250 Hz) every 7th sample with white noise reads the same;
-    on the study's (8 Hz at 143 Hz, every 12th) it read nothing (docs/latent-force.md)."""
+    periods), band-limited and measured at every sample. The missing force is friction on
+    the ground with the equivalent damping taken back, beyond its bands, rising with the
+    load: measured RMS 1.32 N at 250 g (friction 1.06 N, 98 % explained), 2.63 N at 450 g
+    (stick and slip, sliding at 1.23 N, 100 %). On this conversion (a 16 Hz band at 250 Hz)
+    every 7th sample with white noise reads the same; on the study's (8 Hz at 143 Hz, every
+    12th) it read nothing (docs/latent-force.md)."""
     from harvester.diagnosis.floor import output_floor
 
     rms = {}
@@ -161,7 +163,7 @@ def test_the_frames_friction_is_seen_beyond_its_noise_floor_under_a_fitted_basel
         lf = latent_force(state, draws=40, initial_sd=1.0, noise_floor=floor.rms)
         assert lf.noise_in_band and lf.stride == 1
         desc = describe(lf)
-        assert desc.readable and "friction" in desc.best.name, desc.sentence
+        assert desc.readable and desc.best.share > 0.9, desc.sentence
         assert any(is_friction(TERMS[t]) for t in library_terms(desc.best.name))
         assert np.mean(np.abs(lf.force) > 2.0 * lf.sd) > 0.5
         rms[load] = lf.rms_N

@@ -369,14 +369,15 @@ def _stick_runs(x_vel: np.ndarray, vs: float, shortest: int) -> np.ndarray:
     return runs
 
 
-def _stick_slip_fit(f: np.ndarray, x_vel: np.ndarray, held: np.ndarray, runs: np.ndarray
-                    ) -> tuple[float, float, np.ndarray, float]:
-    """(F, b, fitted, share) of f = F sgn(x') while sliding, b held + c_j in stick phase j.
-    The two parts have disjoint supports and c_j is each phase's mean, so the fit is the
-    sliding samples' projection and the phases' demeaned regression (O(samples))."""
+def _stick_slip_fit(f: np.ndarray, x_vel: np.ndarray, z_vel: np.ndarray, held: np.ndarray,
+                    runs: np.ndarray) -> tuple[float, float, float, np.ndarray, float]:
+    """(F, c, b, fitted, share) of f = F sgn(x') + c z' while sliding, b held + c_j in stick
+    phase j (c: the viscous part a fitted baseline's c_m took from the friction). The two
+    parts have disjoint supports and c_j is each phase's mean, so the fit is the sliding
+    samples' least squares and the phases' demeaned regression (O(samples))."""
     stick = runs >= 0
-    slide = np.where(stick, 0.0, np.sign(x_vel))
-    F = float(slide @ f / max(slide @ slide, 1e-300))
+    slide = np.column_stack([np.sign(x_vel), z_vel])[~stick]
+    coef = np.linalg.lstsq(slide, f[~stick], rcond=None)[0] if slide.size else np.zeros(2)
     if stick.any():
         count = np.bincount(runs[stick]).astype(float)
         mean = lambda x: (np.bincount(runs[stick], x[stick]) / count)[runs[stick]]  # noqa: E731
@@ -385,9 +386,10 @@ def _stick_slip_fit(f: np.ndarray, x_vel: np.ndarray, held: np.ndarray, runs: np
         held_part = mean(f) + b * h_dm
     else:
         b, held_part = 0.0, np.empty(0)
-    fitted = F * slide
+    fitted = np.empty_like(f)
+    fitted[~stick] = slide @ coef
     fitted[stick] = held_part
-    return F, b, fitted, _share(f, fitted)
+    return float(coef[0]), float(coef[1]), b, fitted, _share(f, fitted)
 
 
 #: Shortest stick phase (s): a shorter run of |x'| < v_s is a reversal passing through zero.
@@ -398,7 +400,8 @@ def stick_slip_on_ground(lf: LatentForce, f: np.ndarray) -> Shape:
     """Stick and slip of a contact fixed to the ground (Karnopp): while |x'| < v_s (for at
     least SHORTEST_STICK_S) the contact holds the mass where it stuck and carries what eq. (1)
     then leaves, b [-(c_m z' + k z) + (M - m) y''] plus a constant per stick phase (k x_stick;
-    b = 1 is the law, fitted and reported); else it slides with F sgn(x'). v_s (m/s) scanned
+    b = 1 is the law, fitted and reported); else it slides with F sgn(x') + c z' (c the
+    viscous part a fitted baseline's c_m took, as in ``friction``). v_s (m/s) scanned
     from 1e-2 to 0.5 x the RMS of x'. Fitted without the band (the phases are long)."""
     x_vel = lf.rel_vel + base_velocity(lf)
     v = lf.values
@@ -406,16 +409,18 @@ def stick_slip_on_ground(lf: LatentForce, f: np.ndarray) -> Shape:
     held = -(v["c_m"] * lf.rel_vel + v["k"] * lf.rel_disp) + (v["M"] - v["m"]) * yb
     shortest = max(2, int(round(SHORTEST_STICK_S / float(lf.time[1] - lf.time[0]))))
     sv = _rms(x_vel)
-    fits = [(vs, *_stick_slip_fit(f, x_vel, held, _stick_runs(x_vel, vs, shortest)))
+    fits = [(vs, *_stick_slip_fit(f, x_vel, lf.rel_vel, held,
+                                  _stick_runs(x_vel, vs, shortest)))
             for vs in np.geomspace(1e-2 * sv, 0.5 * sv, SCAN_POINTS)]
-    vs, F, b, fitted, share = max(fits, key=lambda r: r[-1])
+    vs, F, c, b, fitted, share = max(fits, key=lambda r: r[-1])
     stuck = float(np.mean(_stick_runs(x_vel, vs, shortest) >= 0))
     scale, vel = lf.units.small("velocity")
-    sentence = (f"stick and slip on the ground: slides at {F:.3g} {lf.units.label('N')}, "
-                f"sticks below {scale * vs:.2g} {vel} ({100 * stuck:.0f} % of the time), "
-                f"{_explains(share)}")
-    return Shape("stick-slip on the ground", share, {"F_N": F, "v_stick_m_per_s": vs,
-                                                     "held_gain": b, "stuck_share": stuck},
+    sentence = (f"stick and slip on the ground: slides at {F:.3g} {lf.units.label('N')} "
+                f"(with {c:.3g} {lf.units.label('N s/m')} of viscous damping), sticks below "
+                f"{scale * vs:.2g} {vel} ({100 * stuck:.0f} % of the time), {_explains(share)}")
+    return Shape("stick-slip on the ground", share, {"F_N": F, "c_N_s_per_m": c,
+                                                     "v_stick_m_per_s": vs, "held_gain": b,
+                                                     "stuck_share": stuck},
                  sentence, fitted)
 
 
