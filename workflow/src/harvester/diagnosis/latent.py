@@ -366,10 +366,10 @@ def latent_force(state: BaselineState, window: tuple[int, int] | None = None, *,
     (marginal likelihood, at most the baseline's sigma; white, every ``stride`` samples),
     'baseline' (its sigma) or a value in the output's unit; a given level is modelled
     band-limited, every sample measured, on a record that fixes the slow motion;
-    ``noise_floor``:
-    the recording's own noise floor (output's unit, ``floor.py``), taken as the noise's level
-    on such a record and ignored on others (``noise`` then); ``draws``: joint draws of the state path
-    behind the sd; ``initial_sd``: :data:`INITIAL_SD`; ``units``: the recording's (labels)."""
+    ``noise_floor``: the recording's own noise floor (output's unit, ``floor.py``), taken as
+    the noise's level on such a record and ignored on others (``noise`` then); ``draws``:
+    joint draws of the state path behind the sd; ``initial_sd``: :data:`INITIAL_SD`;
+    ``units``: the recording's (labels)."""
     if kernel not in MATERN_STATES:
         raise ValueError(f"kernel must be one of {sorted(MATERN_STATES)}, got {kernel!r}")
     clock = time.perf_counter()
