@@ -4,6 +4,7 @@ the library) with forces of known shape get that shape, its period, frequency or
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from pathlib import Path
 
@@ -286,3 +287,17 @@ def test_shapes_of_the_slow_part_do_not_judge_a_name_from_an_acceleration_record
     assert not has_its_shape(desc, ["cubic_stiffness"], 0.0)  # periodic in z, 0.3
     alone = ShapeDescription([slow], 1.0, 0.1, "", slow=frozenset({"line"}))
     assert has_its_shape(alone, ["cubic_stiffness"], 0.0)
+
+
+def test_a_force_that_pushes_along_the_motion_is_not_called_friction():
+    """-1.5 N sgn(z') (energy put in, as a drive that follows the velocity): the friction
+    shapes fit a negative level and explain nothing; a friction level is positive."""
+    from harvester.diagnosis.shapes import passive
+    state = linear_state(recording(rk4_record(lambda z, v, t: -1.5 * np.tanh(v / 1e-3), 12.0),
+                                   "rel_acc"))
+    desc = describe(latent_force(state, draws=40))
+    friction = [s for s in desc.shapes if s.name == "friction"][0]
+    assert friction.share == 0.0 and friction.parameters["F_N"] < -1.0
+    assert not any(is_friction(TERMS[t]) for t in library_terms(desc.best.name)), desc.sentence
+    assert desc.best.name != "drifting friction", desc.sentence
+    assert passive(dataclasses.replace(friction, parameters={"F_N": 1.0}, share=0.5)).share == 0.5

@@ -38,6 +38,7 @@ keep their SI suffixes (``F_N`` holds volts for a recording in volts).
 from __future__ import annotations
 
 import copy
+import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
@@ -46,6 +47,7 @@ from scipy import optimize, signal
 
 from harvester.diagnosis.latent import LatentForce
 from harvester.diagnosis.term_forces import term_force
+from harvester.model.structures import structure
 from harvester.model.terms import TERMS, is_friction, term
 
 #: Points of each scanned parameter's grid before the refinement.
@@ -534,6 +536,8 @@ def describe(lf: LatentForce, dictionary=DICTIONARY) -> ShapeDescription:
     seen, through, mask = determined(lf)
     f = through(lf.force - offset) if seen is not lf else lf.force - offset
     fitted = [shape(seen, f) for shape in dictionary]
+    if not any(is_friction(t) for t in structure(lf.baseline).layout.terms):
+        fitted = [passive(s) for s in fitted]
     slow = slow_shapes(lf, fitted)
     pool = [s for s in fitted if s.name not in slow] or fitted
     top = max(s.share for s in pool)
@@ -548,6 +552,20 @@ def describe(lf: LatentForce, dictionary=DICTIONARY) -> ShapeDescription:
         about = f" about a constant {offset:.3g} {force}" if abs(offset) > 0.1 * rms else ""
         sentence = f"{best.sentence}{about} (RMS {rms:.3g} {force})"
     return ShapeDescription(ranked, rms, sd, sentence, offset, readable, f, mask, slow)
+
+
+def passive(shape: Shape) -> Shape:
+    """``shape``, or, for a friction shape whose level F is not positive, the same shape
+    explaining nothing: a friction takes energy from the motion; one that pushes the mass
+    along its velocity is not friction (the frame's loop read -0.34 N under the linear
+    baseline). A drifting friction's level is its level at the record's start. For a
+    baseline without friction only (:func:`describe`): under one with friction, a negative
+    missing friction is the baseline's taking too much."""
+    family = library_terms(shape.name)
+    friction = shape.name == "drifting friction" or (family and is_friction(TERMS[family[0]]))
+    if not friction or shape.parameters.get("F_N", 1.0) > 0:
+        return shape
+    return dataclasses.replace(shape, share=0.0)
 
 
 #: Share of a shape's fitted power below SLOW_FREQUENCY x the device's natural frequency above
