@@ -312,6 +312,22 @@ def chain_noise(state: BaselineState) -> tuple[np.ndarray, np.ndarray, np.ndarra
                                           int(getattr(p, "filter_order", 8))))
 
 
+def _measurement(dev: _Device, state: BaselineState, fixed: float | None,
+                 noise_floor: float | None) -> float | None:
+    """Sets how ``dev``'s output is measured (module docstring) and returns the noise's level
+    (None: fitted). On a record that fixes the slow motion with a level given (the
+    ``noise_floor`` first, at most the baseline's sigma): band-limited noise, every sample;
+    otherwise white noise every ``measurement_stride`` samples."""
+    sigma_b = float(state.theta[-1])
+    if state.problem.output_type.holds_slow_motion:
+        fixed = fixed if noise_floor is None else min(float(noise_floor), sigma_b)
+        if fixed is not None:
+            dev.noise, dev.floor = chain_noise(state), FLOOR_SHARE * sigma_b
+            return fixed
+    dev.stride = measurement_stride(state)
+    return fixed
+
+
 def _force_scale(dev: _Device, residual: np.ndarray) -> float:
     """The force the baseline's residual implies (N): M x its RMS for an acceleration, k x it
     for a displacement; the search's starting amplitude."""
@@ -378,13 +394,8 @@ def latent_force(state: BaselineState, window: tuple[int, int] | None = None, *,
     dev, residual = _device(state, stop)
     dev.initial_sd = float(initial_sd)
     sigma_b = float(state.theta[-1])
-    fixed = None if noise == "fit" else (sigma_b if noise == "baseline" else float(noise))
-    if noise_floor is not None and p.output_type.holds_slow_motion:
-        fixed = min(float(noise_floor), sigma_b)
-    if fixed is not None and p.output_type.holds_slow_motion:
-        dev.noise, dev.floor = chain_noise(state), FLOOR_SHARE * sigma_b
-    else:
-        dev.stride = measurement_stride(state)
+    fixed = _measurement(dev, state, None if noise == "fit" else (
+        sigma_b if noise == "baseline" else float(noise)), noise_floor)
     length, amp, noise_sd, logml = fit_hyperparameters(
         dev, kernel, _force_scale(dev, residual[start:stop]), fixed or sigma_b, fixed is None)
     filtered, disc, T = _filter(dev, kernel, length, amp, noise_sd)
