@@ -144,7 +144,7 @@ def _states_from_start(lf: LatentForce):
         z, v, a = (x[None, :] for x in (lf.rel_disp, lf.rel_vel, lf.rel_acc))
         return z, v, a, lf.input, 0
     lead = lf.lead_draws.shape[-1]
-    if lead == 0 or lf.lead_draws.shape[1] != lf.state_draws.shape[1]:
+    if lead == 0:
         return (*lf.state_draws, lf.input, 0)
     z, v, a = np.concatenate([lf.lead_draws, lf.state_draws], axis=-1)
     return z, v, a, np.concatenate([lf.lead_input, lf.input]), lead
