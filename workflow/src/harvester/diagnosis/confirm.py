@@ -58,6 +58,7 @@ from harvester.diagnosis.fits import (BRIDGE_MIN_SE, MISSED_MODE_NATS, ModelFit,
                                       prior_dict, scan_factor, support)
 from harvester.diagnosis.screen import Screen
 from harvester.diagnosis.signatures import candidate_terms
+from harvester.diagnosis.smoothness import smoothness
 from harvester.model.priors import DeviceScale
 from harvester.inference.evidence import BridgeEstimate, chains_bridge_log_evidence, log_target
 from harvester.inference.identify import TMCMCSettings, identify
@@ -415,6 +416,13 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
                  len(order))
         result = judged_by_importance(baseline, effect, screened, settings,
                                       seed_offset + 101 * (i + 1))
+        if result is None and rough(screened):
+            result = judged_rough(baseline, effect, screened, settings,
+                                  seed_offset + 101 * (i + 1))
+            if result is None:
+                screened.skipped = rough_reason(screened)
+                log.warning("%s not sampled: %s", effect, screened.skipped)
+                continue
         if result is None:
             point = screened.point if screened is not None and not screened.failed else None
             fit = candidate_fit(baseline, effect, priors, settings, scale, detection,
@@ -442,6 +450,20 @@ def judged_by_importance(baseline: ModelFit, effect: str, screened, settings: Co
     if screened is None or screened.failed or not screened.on_bound \
             or not screened.importance_trusted:
         return None
+    result = _importance_result(baseline, effect, screened, settings, seed)
+    if not result.at_prior_edge:
+        log.info("%s: the draws of its importance-sampling estimate do not pile against a "
+                 "bound: sampled by TMCMC", result.fit.structure.name)
+        return None
+    log.info("%s: judged on its importance-sampling estimate, not by TMCMC: its best fit "
+             "has %s", result.fit.structure.name, screened.pull_phrase(screened.on_bound))
+    return result
+
+
+def _importance_result(baseline: ModelFit, effect: str, screened, settings: ConfirmSettings,
+                       seed: int) -> CandidateResult:
+    """:func:`judge` on draws from the candidate's importance-sampling estimate, its
+    evidence that estimate's."""
     est, p = screened.importance, screened.problem
     chains = max(settings.chains, 1)
     samples = screened.importance_draws(chains * candidate_particles(effect, settings.particles),
@@ -449,16 +471,48 @@ def judged_by_importance(baseline: ModelFit, effect: str, screened, settings: Co
     fit = ModelFit(baseline.structure.with_term(effect), p, samples,
                    np.array([est.log_evidence]), None, priors_for(p, screened.specs),
                    importance=est)
-    result = judge(effect, fit, baseline, settings)
-    if not result.at_prior_edge:
-        log.info("%s: the draws of its importance-sampling estimate do not pile against a "
-                 "bound: sampled by TMCMC", fit.structure.name)
+    log.info("%s: %d draws of its importance-sampling estimate (log evidence %.2f +- %.2f, "
+             "Pareto k %.2f, ESS %.0f of %d)", fit.structure.name, len(samples),
+             est.log_evidence, est.se, est.pareto_k, est.ess, est.draws)
+    return judge(effect, fit, baseline, settings)
+
+
+def rough(screened) -> bool:
+    """Whether a screened candidate's likelihood jumps about its best fit
+    (``smoothness.smoothness``, made here on first use and kept on ``screened``): then
+    TMCMC's random walk cannot sample it (:func:`judged_rough`). False for a candidate not
+    screened or whose fit failed."""
+    if screened is None or screened.failed or screened.point is None:
+        return False
+    if screened.smooth is None:
+        screened.smooth = smoothness(screened.problem, screened.specs, screened.point,
+                                     screened.on_bound)
+        s = screened.smooth
+        log.info("%s: smoothness about its best fit: %s (%d simulations, %.1f s)",
+                 screened.effect, s.phrase(), s.simulations, s.seconds)
+    return screened.smooth.rough
+
+
+def judged_rough(baseline: ModelFit, effect: str, screened, settings: ConfirmSettings,
+                 seed: int) -> CandidateResult | None:
+    """A candidate whose likelihood jumps (:func:`rough`) judged on its importance-sampling
+    estimate where that is trusted: an average of the likelihood over draws, which needs no
+    random walk (its Pareto k says whether the draws found the jumps' peaks). None where the
+    estimate is not trusted: the candidate is then not sampled (:func:`rough_reason`)."""
+    screened.importance_ceiling(settings.mc_sigmas)  # makes the estimate
+    if not screened.importance_trusted:
         return None
-    log.info("%s: judged on %d draws of its importance-sampling estimate (log evidence %.2f "
-             "+- %.2f, Pareto k %.2f, ESS %.0f of %d), not by TMCMC: its best fit has %s",
-             fit.structure.name, len(samples), est.log_evidence, est.se, est.pareto_k,
-             est.ess, est.draws, screened.pull_phrase(screened.on_bound))
-    return result
+    log.info("%s: %s: judged on its importance-sampling estimate, not by TMCMC",
+             effect, screened.smooth.phrase())
+    return _importance_result(baseline, effect, screened, settings, seed)
+
+
+def rough_reason(screened) -> str:
+    """Why a candidate whose likelihood jumps was not sampled, in words."""
+    return (f"{screened.smooth.phrase()}: a Metropolis random walk cannot sample it, and "
+            f"{screened.importance_phrase()}; its best fit gains at most "
+            f"{screened.bound:.1f} nats (Laplace {screened.laplace_gain:+.1f}), which no "
+            "estimate here confirms")
 
 
 def sampling_order(order: list[str], fitted: Mapping) -> tuple[list[str], set[str]]:

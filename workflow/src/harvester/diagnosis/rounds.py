@@ -94,6 +94,7 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
         rnd.confirmed = confirm(now.fit, effects, now.priors, confirmation, scale,
                                 seed_offset=1000 * (r + 1), detection=det, screen=rnd.screen,
                                 top=settings.top)
+        notes += rough_notes(rnd, r)
         best = rnd.accepted
         if best is None:
             unexplained = unexplained or det.significant
@@ -117,3 +118,24 @@ def detect_round(analysis: Analysis, start: BaselineStart, now: Current,
     det = detect(state, analysis.window, now.priors, candidates,
                  replace(ds, seed=ds.seed + r), time=analysis.time)
     return Round(now.structure.name, det, state, rank(det, state, now.priors))
+
+
+def rough_rivals(rnd: Round) -> list:
+    """The round's candidates (``screen.Screened``) that were not sampled because their
+    likelihood jumps (``confirm.rough``) while their best fit, by Laplace, gains more than
+    every candidate accepted: the round's names stand against what could be sampled, not
+    against them."""
+    best = rnd.accepted
+    return [s for s in (rnd.screen.candidates if rnd.screen is not None else [])
+            if s.smooth is not None and s.smooth.rough and not s.sampled
+            and (best is None or s.laplace_gain > best.delta_log_evidence)]
+
+
+def rough_notes(rnd: Round, r: int) -> list[str]:
+    """:func:`rough_rivals` of round ``r`` (from 0) in words."""
+    best = rnd.accepted
+    than = "" if best is None else f", above {best.effect}'s {best.delta_log_evidence:+.1f}"
+    return [f"round {r + 1}: {s.effect} fits better at its best fit (Laplace "
+            f"{s.laplace_gain:+.1f} nats{than}) but was not sampled: {s.smooth.phrase()}; "
+            "the round's names stand against the candidates that could be sampled"
+            for s in rough_rivals(rnd)]

@@ -124,6 +124,9 @@ class Screened:
     #: the candidate's problem and priors, as its fit and its estimate used them
     problem: object = field(default=None, repr=False)
     specs: dict[str, PriorSpec] = field(default_factory=dict, repr=False)
+    #: the likelihood's smoothness about the MAP (``smoothness.Smoothness``), checked before
+    #: TMCMC (``confirm.rough``); None where it was not
+    smooth: object = None
 
     @property
     def pulled(self) -> dict[str, tuple[str, float]]:
@@ -186,6 +189,7 @@ class Screened:
                 "map_on_bound": {n: {"side": side, "drop_nats": drop,
                                      "posterior_must_pile": drop > PILE_NATS}
                                  for n, (side, drop) in self.on_bound.items()},
+                "smoothness": None if self.smooth is None else self.smooth.to_dict(),
                 "sampled": self.sampled, "skipped": self.skipped}
 
 

@@ -29,7 +29,7 @@ from harvester.diagnosis.fits import ModelFit
 from harvester.diagnosis.detect import Detection
 from harvester.diagnosis.floor import Floor
 from harvester.diagnosis.missing_force import MissingForce
-from harvester.diagnosis.rounds import Round
+from harvester.diagnosis.rounds import Round, rough_rivals
 from harvester.diagnosis.separate import Separation, separations
 from harvester.diagnosis.shapes import beyond_uncertainty, has_its_shape, library_terms
 from harvester.diagnosis.settings import DiagnosisSettings
@@ -174,6 +174,9 @@ class Conclusion:
     headline: str = ""
     named_fit: ModelFit | None = None
     withheld: list[str] = field(default_factory=list)
+    #: candidates that fit better than the names but could not be sampled (their likelihood
+    #: jumps: ``rounds.rough_rivals``)
+    unsampled: list[str] = field(default_factory=list)
 
 
 def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings,
@@ -199,7 +202,8 @@ def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings
     named = [a.fit for a in accepted if a.named]
     return Conclusion(verdict, missing, ties, bool(unexplained), notes,
                       accepted[-1].fit if accepted else None, bool(accepted),
-                      named_fit=named[-1] if named else None)
+                      named_fit=named[-1] if named else None,
+                      unsampled=[c.effect for rnd in rounds for c in rough_rivals(rnd)])
 
 
 def withheld_names(found: Conclusion, missing: MissingForce | None) -> str | None:
@@ -333,6 +337,9 @@ def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
     if found.withheld:
         parts.append(f"no library name: {', '.join(found.withheld)} lack the missing force's "
                      "shape")
+    if found.unsampled:
+        parts.append(f"{', '.join(found.unsampled)} fits better at its best fit but could not "
+                     "be sampled (its likelihood jumps)")
     share = fit.library_share()
     if verdict != "adequate":
         parts.append(_library_phrase(share, found.accepted))
