@@ -205,6 +205,12 @@ def test_a_named_term_is_checked_against_the_missing_forces_shape():
     assert not has_its_shape(desc, ["cubic_stiffness"], share)
     found = Conclusion("missing_physics", ["cubic_stiffness"], [], False, [], None, True)
     assert "cubic_stiffness accepted by evidence" in withheld_names(found, out)
+    # where the evidence judged friction's terms on the record, their shape does not
+    # overrule the name the evidence accepted
+    from dataclasses import replace
+    assert withheld_names(replace(found, tried={"cubic_stiffness", "coulomb_friction"}),
+                          out) is None
+    found = replace(found, tried={"cubic_stiffness", "coulomb_friction", "end_stop"})
     periodic = lambda z, v, t: 5.0 * np.sin(2 * np.pi * z / 0.02)  # noqa: E731
     desc, share, out = _named_beside(periodic, "linear+cubic_stiffness", [60.0, 1e6],
                                      "cubic_stiffness")

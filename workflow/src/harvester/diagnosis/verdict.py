@@ -177,6 +177,8 @@ class Conclusion:
     #: candidates that fit better than the names but could not be sampled (their likelihood
     #: jumps: ``rounds.rough_rivals``)
     unsampled: list[str] = field(default_factory=list)
+    #: every effect the rounds screened or sampled (the evidence's verdict on it is in)
+    tried: set[str] = field(default_factory=set)
 
 
 def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings,
@@ -203,7 +205,15 @@ def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings
     return Conclusion(verdict, missing, ties, bool(unexplained), notes,
                       accepted[-1].fit if accepted else None, bool(accepted),
                       named_fit=named[-1] if named else None,
-                      unsampled=[c.effect for rnd in rounds for c in rough_rivals(rnd)])
+                      unsampled=[c.effect for rnd in rounds for c in rough_rivals(rnd)],
+                      tried=tried_effects(rounds))
+
+
+def tried_effects(rounds: list[Round]) -> set[str]:
+    """The effects the rounds screened by their best fit or sampled."""
+    out = {r.effect for rnd in rounds for r in rnd.confirmed}
+    return out | {c.effect for rnd in rounds if rnd.screen is not None
+                  for c in rnd.screen.candidates}
 
 
 def withheld_names(found: Conclusion, missing: MissingForce | None) -> str | None:
@@ -211,7 +221,11 @@ def withheld_names(found: Conclusion, missing: MissingForce | None) -> str | Non
     force can be read, and the added terms' force together lacks its shape
     (``shapes.has_its_shape``): the frame's hysteresis, the best shape friction, keeps its
     name; a Stribeck friction and a mode whose force explains 1.5 % of a friction level
-    drifting in time (14.5 %, the literature generator's friction drift) do not."""
+    drifting in time (14.5 %, the literature generator's friction drift) do not. A shape the
+    library holds whose terms the rounds screened or sampled (``Conclusion.tried``) does not
+    overrule the evidence, which fitted those terms to the record itself: LuGre's and
+    Bouc-Wen's hysteresis were withheld for "odd in z" at 31 % and 14 % of an acceleration
+    record's latent force, whose cubic spring and end stop had fallen short by evidence."""
     sizes = [] if missing is None else [s for s in missing.sizes if not s.negligible]
     if not sizes or not (found.missing or found.ties):
         return None
@@ -219,6 +233,8 @@ def withheld_names(found: Conclusion, missing: MissingForce | None) -> str | Non
     if has_its_shape(desc, [s.term for s in sizes], share):
         return None
     terms = library_terms(desc.best.name)
+    if set(terms) & found.tried:
+        return None  # the evidence judged that shape's terms on this record: its say stands
     has = (f" (the library's {' / '.join(terms)}, of this shape, was not accepted by evidence)"
            if terms else " (outside the library)")
     return (f"{' + '.join(s.term for s in sizes)} accepted by evidence, but their force "
