@@ -32,6 +32,7 @@ class FakeProblem:
     calls: list = field(default_factory=list)
     structure = SimpleNamespace(free_parameters=("a", "b"))
     parameter_names = ("a", "b", "sigma")
+    n_data = 100
 
     def residual_sums(self, theta):
         theta = np.atleast_2d(theta)[:, :2]

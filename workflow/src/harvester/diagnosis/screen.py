@@ -218,13 +218,22 @@ def max_loglike(problem, theta: np.ndarray) -> float:
 
 def _profiled(problem, theta: np.ndarray) -> tuple[float, float]:
     """(max log L over sigma, that sigma) at the free parameters of ``theta``: one
-    simulation (``Problem.profiled_loglike``)."""
-    row = np.append(np.asarray(theta, dtype=float)[:len(problem.structure.free_parameters)],
-                    1.0)[None, :]
-    sse, ok = problem.residual_sums(row)
-    if not ok[0] or not np.isfinite(sse[0]) or sse[0] <= 0.0:
-        return -np.inf, np.nan
-    return float(problem.profiled_loglike(sse[0])), float(np.sqrt(sse[0] / problem.n_data))
+    simulation (:func:`profiled_rows`)."""
+    free = np.asarray(theta, dtype=float)[:len(problem.structure.free_parameters)]
+    ll, sigma = profiled_rows(problem, free[None, :])
+    return float(ll[0]), float(sigma[0])
+
+
+def profiled_rows(problem, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(max log L over sigma, that sigma) per row of free parameters, one batch of
+    simulations (``Problem.profiled_loglike``); -inf and nan where a simulation fails."""
+    theta = np.atleast_2d(np.asarray(theta, dtype=float))
+    sse, ok = problem.residual_sums(np.column_stack([theta, np.ones(len(theta))]))
+    good = ok & np.isfinite(sse) & (sse > 0.0)
+    ll, sigma = np.full(len(theta), -np.inf), np.full(len(theta), np.nan)
+    ll[good] = problem.profiled_loglike(sse[good])
+    sigma[good] = np.sqrt(sse[good] / problem.n_data)
+    return ll, sigma
 
 
 def fit_value(problem, theta: np.ndarray, priors: Mapping[str, PriorSpec],

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from harvester.diagnosis.baseline import PointFit, PriorCoordinates
+from harvester.diagnosis.screen import profiled_rows
 from harvester.inference.priors import PriorSpec
 
 #: Steps from the MAP along each parameter, in its Laplace standard deviation.
@@ -97,7 +98,7 @@ def smoothness(problem, specs: Mapping[str, PriorSpec], point: PointFit,
         for t in _steps(coords, u0, step):
             rows.append(u0 + t * step)
             where.append((k, t))
-    ll = _loglike(problem, coords.theta(np.array(rows)))
+    ll, _ = profiled_rows(problem, coords.theta(np.array(rows)))
     departures: dict[str, float] = {}
     for k, dep in _departures(ll[0], ll[1:], where).items():
         departures[labels[k]] = max(dep, departures.get(labels[k], 0.0))
@@ -128,15 +129,6 @@ def _steps(coords: PriorCoordinates, u0: np.ndarray, step: np.ndarray) -> list[f
         reach = min(1.0, float(np.min(room)) * (1.0 - 1e-9))
         if reach > 0:
             out += [t * reach for t in PROBES if t * side > 0]
-    return out
-
-
-def _loglike(problem, theta: np.ndarray) -> np.ndarray:
-    """Profiled tempered log-likelihood per row of free parameters (-inf: failed)."""
-    sse, ok = problem.residual_sums(np.column_stack([theta, np.ones(len(theta))]))
-    out = np.full(len(theta), -np.inf)
-    good = ok & np.isfinite(sse) & (sse > 0)
-    out[good] = problem.profiled_loglike(sse[good])
     return out
 
 
