@@ -13,8 +13,10 @@ the Rauch-Tung-Striebel smoother are exact, with no linearisation of sign-like l
 extended filter would turn into a gain of F_c / 1 mm/s. This is the restoring-force surface's
 logic (Masri and Caughey 1979: the force beyond the known linear part, from the measured
 motion) and the GPLFM's (a known linear model plus a latent force), with the baseline's terms
-taken out afterwards: f = g - sum_T X_T along joint draws of the smoothed state path (forward
-filtering, backward sampling), which carries the states' uncertainty into f.
+taken out afterwards: f = g - W sum_T X_T along joint draws of the smoothed state path
+(forward filtering, backward sampling), which carries the states' uncertainty into f; W is
+the smoother's own response (``smoother_response``), through which the posterior mean sees
+any force and through which every force compared with it goes (``LatentForce.band``).
 
 Band. The recording holds the motion only inside the measurement chain's band (the
 likelihood's low-pass, ``ChainProblem.band_hz``), so the force is estimated inside it: the
@@ -29,8 +31,9 @@ the filter's memory after it. Two ways to measure it:
   the stop band holds beyond the filter's response is a floor of FLOOR_SHARE x the
   baseline's sigma. Every 12th sample of the frame's displacement (an 8 Hz band at 143 Hz)
   was too few to see its friction (docs/latent-force.md).
-* otherwise the output is measured every ``stride`` samples, fs / (2 band) (8 at 256 Hz for
-  a 20 Hz recording), where the band-limited noise is close to independent, as white noise.
+* otherwise the output is measured every ``stride`` samples, fs / (2 band) rounded up (7 at
+  256 Hz for a 20 Hz recording), where the band-limited noise is close to independent, as
+  white noise (``measurement_stride``).
   With its level free, band-limited noise explains a mismatch whose spectrum is as flat as a
   sign law's as well as a force does (a 6 N Coulomb friction missing from a 12 s z''
   record: the noise at the baseline's sigma scored 4000 nats above the force with the noise
@@ -55,7 +58,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import linalg, optimize
+from scipy import linalg, optimize, signal
 
 from harvester.data.signals import butterworth_sos, lowpass
 from harvester.data.units import SI, Units
@@ -114,6 +117,8 @@ class LatentForce:
     lead_input: np.ndarray = field(repr=False, default_factory=lambda: np.empty(0))
     #: the recording's units (``data.units``): "N" and "m" above stand for them
     units: Units = SI
+    #: the smoother's response W (``smoother_response``), None: the identity
+    response: np.ndarray | None = field(repr=False, default=None)
 
     @property
     def lower(self) -> np.ndarray:
@@ -128,9 +133,11 @@ class LatentForce:
         return float(np.sqrt(np.mean(self.force**2)))
 
     def band(self, x: np.ndarray) -> np.ndarray:
-        """``x`` (samples along the last axis) through the band's low-pass, as the force."""
+        """A force ``x`` (samples along the last axis) as the posterior mean sees it: through
+        the smoother's response and the band's low-pass."""
+        x = through_response(x, self.response)
         if not np.isfinite(self.band_hz):
-            return np.asarray(x, dtype=float)
+            return x
         fs = 1.0 / float(self.time[1] - self.time[0])
         return lowpass(x, fs, self.band_hz, self.filter_order)
 
@@ -254,13 +261,61 @@ def _with_chain_noise(disc: Discrete, H, D, P0, T, dev: _Device, noise: float):
             linalg.block_diag(P0, Pn), np.concatenate([T, np.ones(m)]))
 
 
-def _filter(dev: _Device, kernel: str, length: float, amp: float, noise: float):
-    disc, H, D, R, m0, P0, T = _model(dev, kernel, length, amp, noise)
+def _measured(dev: _Device) -> np.ndarray:
     measured = np.zeros(len(dev.y), dtype=bool)
     measured[::dev.stride] = True
+    return measured
+
+
+def _filter(dev: _Device, kernel: str, length: float, amp: float, noise: float):
+    disc, H, D, R, m0, P0, T = _model(dev, kernel, length, amp, noise)
     out = kalman_filter(disc.Phi, disc.G0, disc.G1, disc.Q, H, D, R, dev.drive, dev.y,
-                        measured, m0, P0)
+                        _measured(dev), m0, P0)
     return out, disc, T
+
+
+#: The smoother's response is kept out to where it falls below this share of its peak.
+RESPONSE_TAIL = 1e-4
+
+
+def smoother_response(dev: _Device, kernel: str, length: float, amp: float, noise: float,
+                      centre: int) -> np.ndarray:
+    """The smoother's response W (odd length, centred): the posterior mean of the force is
+    W * f + (noise) for a true force f, a linear filter in the record's interior, which
+    shrinks what the measurement sees poorly (a z'' record's slow forces, a noisy
+    displacement's fast ones). Found by smoothing the noise-free response to a one-sample
+    force pulse at ``centre`` (averaged over the measurement's phases when only every
+    ``stride``-th sample is measured). A force compared with the posterior mean (a shape,
+    a named term's, the baseline's own terms) goes through W first: like with like."""
+    disc, H, D, R, m0, P0, T = _model(dev, kernel, length, amp, noise)
+    n, out = len(dev.y), np.zeros(len(dev.y))
+    for phase in range(dev.stride):
+        j = centre + phase
+        x, y = np.zeros((n, len(m0))), np.zeros(n)
+        x[j] = -disc.G1  # a force f enters eq. (1) as a drive of -f
+        x[j + 1] = disc.Phi @ x[j] - disc.G0
+        for k in range(j + 1, n - 1):
+            x[k + 1] = disc.Phi @ x[k]
+        y = x @ H
+        y[j] -= D
+        mf, Pf, mp, Pp, _ = kalman_filter(disc.Phi, disc.G0, disc.G1, disc.Q, H, D, R,
+                                          np.zeros(n), y, _measured(dev), np.zeros(len(m0)),
+                                          P0)
+        ms, _, _ = rts_smoother(disc.Phi, mf, Pf, mp, Pp)
+        out += np.roll(ms[:, 2] * T[2], -phase) / dev.stride
+    keep = np.nonzero(np.abs(out) > RESPONSE_TAIL * np.max(np.abs(out)))[0]
+    half = min(int(max(centre - keep[0], keep[-1] - centre)), centre, n - 1 - centre)
+    return out[centre - half:centre + half + 1]
+
+
+def through_response(x: np.ndarray, response: np.ndarray | None) -> np.ndarray:
+    """``x`` (samples along the last axis) through the smoother's response (centred)."""
+    if response is None or response.size == 1 and response[0] == 1.0:
+        return np.asarray(x, dtype=float)
+    x = np.asarray(x, dtype=float)
+    half = response.size // 2
+    full = signal.fftconvolve(x, response.reshape((1,) * (x.ndim - 1) + (-1,)), axes=-1)
+    return full[..., half:half + x.shape[-1]]
 
 
 def fit_hyperparameters(dev: _Device, kernel: str, amp0: float, noise_max: float,
@@ -294,11 +349,17 @@ def fit_hyperparameters(dev: _Device, kernel: str, amp0: float, noise_max: float
 
 def measurement_stride(state: BaselineState) -> int:
     """Samples between the outputs the smoother measures with white noise: fs / (2 x the
-    chain's band), where the band-limited noise is close to independent (1 without a band
-    below Nyquist)."""
+    chain's band) rounded up, so that the measured samples' Nyquist frequency lies inside
+    the band and the band-limited noise is close to independent (1 without a band below
+    Nyquist). Rounded down, the samples keep part of the noise's stop band, and a noise with
+    a stop band is predictable from its past: at a band of 0.32 fs (stride 1, the band an
+    unfiltered record gets) the marginal likelihood put the noise at 0.15 x its floor and read
+    the rest as a force, 4-67 x the truth's on the literature grid (docs/latent-force.md)."""
     p = state.problem
     band = getattr(p, "band_hz", None)
-    return 1 if band is None else max(1, int(np.floor(0.5 / (p.dt * band))))
+    if band is None or not np.isfinite(band):
+        return 1
+    return max(1, int(np.ceil(0.5 / (p.dt * band) - 1e-9)))
 
 
 def chain_noise(state: BaselineState) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
@@ -359,15 +420,22 @@ def _terms_along(state: BaselineState, dev: _Device, z, v, g) -> np.ndarray:
     return sum(forces.values())
 
 
-def _forces(state: BaselineState, dev: _Device, mean: np.ndarray, paths: np.ndarray
-            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _forces(state: BaselineState, dev: _Device, mean: np.ndarray, paths: np.ndarray,
+            response: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(f's posterior mean, its draws, the baseline's term forces along the mean path), each
-    through the band (N): f = g - sum_T X_T per draw; without terms f's mean is the
-    smoother's own, exact."""
+    through the band (N): f = g - W sum_T X_T per draw, the terms through the smoother's
+    response W as g's smoothed mean holds them (a sharp tanh friction's switches, which g
+    cannot follow, left a friction-like force of the opposite sign: -0.37 N, z-score 15, on
+    an effect-free record of the literature grid); without terms f's mean is the smoother's
+    own, exact."""
     band = state.problem.chain
+
+    def terms(z, v, g):
+        return band(through_response(_terms_along(state, dev, z, v, g), response))
+
     z, v, g = paths[..., 0], paths[..., 1], paths[..., 2]
-    f_paths = band(g - _terms_along(state, dev, z, v, g))
-    terms_mean = band(_terms_along(state, dev, mean[:, 0], mean[:, 1], mean[:, 2])[0])
+    f_paths = band(g) - terms(z, v, g)
+    terms_mean = terms(mean[:, 0], mean[:, 1], mean[:, 2])[0]
     if not state.problem.structure.layout.terms:
         return band(mean[:, 2]), f_paths, terms_mean
     return f_paths.mean(axis=0), f_paths, terms_mean
@@ -400,7 +468,8 @@ def latent_force(state: BaselineState, window: tuple[int, int] | None = None, *,
         dev, kernel, _force_scale(dev, residual[start:stop]), fixed or sigma_b, fixed is None)
     filtered, disc, T = _filter(dev, kernel, length, amp, noise_sd)
     mean, paths = _paths(dev, disc, T, filtered, draws, seed)
-    force, f_paths, terms_mean = _forces(state, dev, mean, paths)
+    response = smoother_response(dev, kernel, length, amp, noise_sd, (start + stop) // 2)
+    force, f_paths, terms_mean = _forces(state, dev, mean, paths, response)
     w = slice(start, stop)
     z, v, g = paths[..., 0], paths[..., 1], paths[..., 2]
     states = np.stack([z, v, _acceleration(dev, z, v, g)])
@@ -416,7 +485,7 @@ def latent_force(state: BaselineState, window: tuple[int, int] | None = None, *,
         noise_in_band=dev.noise is not None,
         seconds=time.perf_counter() - clock, filter_order=int(getattr(p, "filter_order", 8)),
         draws=f_paths[:, w], state_draws=states[..., w], lead_draws=states[..., :start],
-        lead_input=dev.input[:start], units=units)
+        lead_input=dev.input[:start], units=units, response=response)
     unit = units.label("force")
     log.info("latent force of %s: RMS %.3g %s (sd %.2g %s), length scale %.3g s, noise %.3g "
              "(baseline's sigma %.3g), %.1f s", p.structure.name, out.rms_N, unit,
