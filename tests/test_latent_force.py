@@ -14,7 +14,7 @@ import pandas as pd
 
 from latent_records import C_M, FS, linear_state, recording, rk4_record
 from harvester.diagnosis.baseline import ChainProblem, baseline_state
-from harvester.diagnosis.latent import latent_force
+from harvester.diagnosis.latent import latent_force, through_response
 from harvester.diagnosis.latent_views import binned, effect_force, views
 from harvester.diagnosis.shapes import describe
 from harvester.data.signals import butterworth_sos, lowpass
@@ -175,7 +175,7 @@ def test_the_posterior_mean_sees_a_force_through_the_smoothers_response():
     state = linear_state(recording(truth, "rel_acc"))
     lf = latent_force(state, draws=20)
     w = slice(*state.problem.window)
-    seen = lf.band(truth["f"])[w]
+    seen = state.problem.chain(through_response(truth["f"], lf.response))[w]
     banded = state.problem.chain(truth["f"])[w]
     err = lambda x: np.sqrt(np.mean((lf.force - x) ** 2))  # noqa: E731
     assert err(seen) < 0.65 * err(banded), (err(seen), err(banded))

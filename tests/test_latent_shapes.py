@@ -307,3 +307,39 @@ def test_a_force_that_pushes_along_the_motion_is_not_called_friction():
     assert not any(is_friction(TERMS[t]) for t in library_terms(desc.best.name)), desc.sentence
     assert desc.best.name != "drifting friction", desc.sentence
     assert passive(dataclasses.replace(friction, parameters={"F_N": 1.0}, share=0.5)).share == 0.5
+
+
+def _noisy_latent(level: float, n: int = 4000, draws: int = 100, seed: int = 0):
+    """A latent force of Coulomb friction ``level`` (N) on a 1 Hz motion plus a posterior
+    mean's shrunk noise (0.3 N), each sample's sd 1 N and its draws independent N(0, 1)
+    about the mean (white posterior spread)."""
+    from harvester.diagnosis.latent import LatentForce
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) * 0.01
+    z = 1e-3 * np.sin(2 * np.pi * t + 0.3 * np.sin(0.7 * t))
+    v = np.gradient(z, t)
+    f = level * np.tanh(v / 1e-4) + 0.3 * rng.standard_normal(n)
+    zeros = np.zeros(n)
+    return LatentForce(t, f, np.ones(n), z, np.full(n, 1e-6), v, np.gradient(v, t), zeros,
+                       zeros, "linear", {"M": 1.0, "m": 1.0, "k": 10.0, "c_m": 0.1}, "force",
+                       "rel_disp", "matern52", 0.1, 1.0, 1e-4, 1e-4, 0.0, np.inf, 1, 0.0,
+                       draws=f + rng.standard_normal((draws, n)))
+
+
+def test_a_shape_can_stand_out_where_no_sample_does():
+    """Friction of 0.3 N under a 1 N sd at every sample: no sample stands out (mean (f/sd)^2
+    0.18), but fitted over 4000 samples its shape stands 0.3 sqrt(4000) = 19 sd out of the
+    draws' spread along it, and is read; where the mean is the shrunk noise alone no shape
+    stands out by half the threshold (the scanned shapes' best fit of it)."""
+    from harvester.diagnosis.shapes import SHAPE_SD, beyond_uncertainty, standing
+    lf = _noisy_latent(0.3)
+    desc = describe(lf)
+    assert not beyond_uncertainty(lf)
+    assert desc.readable and desc.best.name == "friction"
+    assert desc.best.standing_sd == pytest.approx(0.3 * np.sqrt(4000), rel=0.15)
+    assert "sample by sample; the shape stands" in desc.sentence
+    none = describe(_noisy_latent(0.0))
+    assert not none.readable and max(s.standing_sd for s in none.shapes) < SHAPE_SD / 2
+    assert none.sentence.startswith("no missing force")
+    shape = desc.best
+    assert standing(shape, None) != standing(shape, None)  # NaN: nothing to stand out of
