@@ -239,6 +239,29 @@ def test_a_named_term_is_checked_against_the_missing_forces_shape():
     assert "the missing force: a force periodic in z" in judged.headline
 
 
+def test_an_adequate_verdict_says_when_the_missing_force_stands_out():
+    """A verdict left adequate (the detection's p at 0.3) notes a missing force that stands
+    out of its uncertainty, with its description; with none missing, no such note."""
+    from types import SimpleNamespace
+
+    from harvester.diagnosis.missing_force import missing_force
+    from harvester.diagnosis.settings import DiagnosisSettings
+    from harvester.diagnosis.verdict import Conclusion, FitJudgement, judge
+    found = Conclusion("adequate", [], [], False, [], None, False)
+    detection = SimpleNamespace(p_value=0.3, significant=False, conflict=False)
+    fit = FitJudgement(0.98, 0.14, "holdout", 1.0, None, None)
+    notes = {}
+    for name, force in (("friction", lambda z, v, t: 6.0 * np.tanh(v / 1e-3)),
+                        ("none", lambda z, v, t: 0.0 * z)):
+        out = missing_force(linear_state(recording(rk4_record(force, 12.0), "rel_acc")),
+                            draws=20)
+        judged = judge(found, detection, fit, "linear", DiagnosisSettings(), out)
+        assert judged.verdict == "adequate"
+        notes[name] = [n for n in judged.notes if "still stands out" in n]
+    assert len(notes["friction"]) == 1 and "friction-like" in notes["friction"][0]
+    assert notes["none"] == []
+
+
 def test_a_force_within_its_uncertainty_checks_no_name():
     """No missing force (the baseline at the truth): nothing to check a name against, so a
     name is never withheld for it, and no shape claims a share of a force that is not

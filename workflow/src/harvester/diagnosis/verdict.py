@@ -288,6 +288,9 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
                      f"while it is {fit.ratio:.3g} x the recording's noise floor; its model, the "
                      "baseline driven by a smooth force, does not fit this residual (not: "
                      "nothing is missing)")
+    if verdict == "adequate" and missing is not None and missing.description.readable:
+        notes.append("below the verdict's bar, the missing force still stands out of its "
+                     f"uncertainty: {missing.description.sentence}")
     if fit.floor is None:
         notes.append("no noise floor of the recording's own could be measured (no repeated "
                      "periods, quiet lead-in or white band): the verdict rests on the "
