@@ -89,8 +89,7 @@ def test_library_like_shapes_get_their_size(name, force, output, parameter, valu
     """Coulomb friction (6 N) and a cubic spring (2e6 N/m^3): their shapes, and sizes within
     10 %. The friction's size is its force at the motion's RMS speed: from z'' the smoothed
     velocity's error (2.4 mm/s on 13.7 mm/s) lets the level F and the viscous part trade
-    (6.76 N with -13 N s/m through the smoother's response, 5.86 N with -2.4 N s/m without;
-    docs/latent-force.md). From z'' the cubic's size is not given: the displacement's slow
+    (6.36 N with -18.1 N s/m here; 5.99 N at the RMS speed; docs/latent-force.md). From z'' the cubic's size is not given: the displacement's slow
     uncertainty (2 mm on 7 mm RMS) biases a power of z (k_3 came out 0.8e6 and 2.3e6 on two
     records)."""
     desc = _described(force, output)

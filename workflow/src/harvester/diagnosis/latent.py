@@ -15,8 +15,8 @@ logic (Masri and Caughey 1979: the force beyond the known linear part, from the 
 motion) and the GPLFM's (a known linear model plus a latent force), with the baseline's terms
 taken out afterwards: f = g - W sum_T X_T along joint draws of the smoothed state path
 (forward filtering, backward sampling), which carries the states' uncertainty into f; W is
-the smoother's own response (``smoother_response``), through which the posterior mean sees
-any force and through which every force compared with it goes (``LatentForce.band``).
+the smoother's own response (``smoother_response``), through which g's posterior mean holds
+the baseline's terms.
 
 Band. The recording holds the motion only inside the measurement chain's band (the
 likelihood's low-pass, ``ChainProblem.band_hz``), so the force is estimated inside it: the
@@ -133,11 +133,9 @@ class LatentForce:
         return float(np.sqrt(np.mean(self.force**2)))
 
     def band(self, x: np.ndarray) -> np.ndarray:
-        """A force ``x`` (samples along the last axis) as the posterior mean sees it: through
-        the smoother's response and the band's low-pass."""
-        x = through_response(x, self.response)
+        """``x`` (samples along the last axis) through the band's low-pass, as the force."""
         if not np.isfinite(self.band_hz):
-            return x
+            return np.asarray(x, dtype=float)
         fs = 1.0 / float(self.time[1] - self.time[0])
         return lowpass(x, fs, self.band_hz, self.filter_order)
 
@@ -285,9 +283,9 @@ def smoother_response(dev: _Device, kernel: str, length: float, amp: float, nois
     shrinks what the measurement sees poorly (a z'' record's slow forces, a noisy
     displacement's fast ones). Found by smoothing the noise-free response to a one-sample
     force pulse at ``centre`` (averaged over the measurement's phases when only every
-    ``stride``-th sample is measured). A force compared with the posterior mean (a shape's
-    bases, a named term's force, the baseline's own terms) goes through W first: like with
-    like (docs/latent-force.md)."""
+    ``stride``-th sample is measured). The baseline's own terms go through W before they
+    are taken from g (``_forces``); the shapes' bases, built on the smoothed states, do not
+    (docs/latent-force.md)."""
     disc, H, D, R, m0, P0, T = _model(dev, kernel, length, amp, noise)
     n, out = len(dev.y), np.zeros(len(dev.y))
     for phase in range(dev.stride):
