@@ -615,8 +615,9 @@ def slow_shapes(lf: LatentForce, shapes: Sequence[Shape]) -> frozenset:
     SLOW_FREQUENCY x f_n (f_n = sqrt(k / M) / 2 pi, the baseline's), on an acceleration
     record only: z'' responds to a force below the resonance by (f / f_n)^2 of what it does
     at it, so the smoother's slow part is its prior more than the data. On the literature
-    generator's records at half the noise RMS the latent force's RMS was 4-67 x the truth's,
-    best fitted by a line at 0.23-0.49 Hz or by stick-slip's constants per stick phase
+    generator's records at half the noise RMS the latent force's RMS was 4-67 x the truth's
+    (the stride rounded down, before 106b3e0), best fitted by a line at 0.23-0.49 Hz or by
+    stick-slip's constants per stick phase
     (devices of 5.7-6 Hz). Shares below f_n / 3 on the eight records of forms outside the
     library and a cubic spring's test record: lines 0.97-1.0, drifts 0.73-0.99, stick-slip
     0.57-0.62 where it fitted the slow part; the cubic spring's odd shape 0.33."""
