@@ -379,3 +379,23 @@ def test_a_shape_can_stand_out_where_no_sample_does():
     assert none.sentence.startswith("no missing force")
     shape = desc.best
     assert standing(shape, None) != standing(shape, None)  # NaN: nothing to stand out of
+
+
+def test_a_lines_amplitude_is_the_forces_not_what_the_smoother_holds():
+    """A 2 N line at 7 Hz that the posterior mean holds through a response W of gain 0.28
+    there (an 11-tap moving average at 100 Hz): the line shape gives 2 N back, and
+    ``response_gain`` is the moving average's own |W(f)|."""
+    from harvester.diagnosis.latent import through_response
+    from harvester.diagnosis.shapes import line, response_gain
+    lf = _noisy_latent(0.0)
+    h = np.full(11, 1.0 / 11.0)
+    seen = through_response(2.0 * np.cos(2 * np.pi * 7.0 * lf.time), h)
+    broadband = np.random.default_rng(1).standard_normal(lf.time.size)  # not a harmonic drive
+    lf = dataclasses.replace(lf, force=seen, response=h, input=broadband)
+    dt = 0.01
+    exact = abs(np.sum(h * np.exp(-2j * np.pi * 7.0 * (np.arange(11) - 5) * dt)))
+    assert response_gain(lf, 7.0) == pytest.approx(exact, rel=1e-9)
+    assert 0.2 < exact < 0.35
+    shape = line(lf, seen - seen.mean())
+    assert shape.parameters["frequency_hz"] == pytest.approx(7.0, abs=0.01)
+    assert shape.parameters["amplitude_N"] == pytest.approx(2.0, rel=0.02)
