@@ -288,9 +288,10 @@ def smoother_response(dev: _Device, kernel: str, length: float, amp: float, nois
     (docs/latent-force.md)."""
     disc, H, D, R, m0, P0, T = _model(dev, kernel, length, amp, noise)
     n, out = len(dev.y), np.zeros(len(dev.y))
-    for phase in range(dev.stride):
+    phases = [p for p in range(dev.stride) if centre + p + 1 < n]
+    for phase in phases:
         j = centre + phase
-        x, y = np.zeros((n, len(m0))), np.zeros(n)
+        x = np.zeros((n, len(m0)))
         x[j] = -disc.G1  # a force f enters eq. (1) as a drive of -f
         x[j + 1] = disc.Phi @ x[j] - disc.G0
         for k in range(j + 1, n - 1):
@@ -301,7 +302,7 @@ def smoother_response(dev: _Device, kernel: str, length: float, amp: float, nois
                                           np.zeros(n), y, _measured(dev), np.zeros(len(m0)),
                                           P0)
         ms, _, _ = rts_smoother(disc.Phi, mf, Pf, mp, Pp)
-        out += np.roll(ms[:, 2] * T[2], -phase) / dev.stride
+        out += np.roll(ms[:, 2] * T[2], -phase) / len(phases)
     keep = np.nonzero(np.abs(out) > RESPONSE_TAIL * np.max(np.abs(out)))[0]
     half = min(int(max(centre - keep[0], keep[-1] - centre)), centre, n - 1 - centre)
     return out[centre - half:centre + half + 1]
