@@ -144,3 +144,21 @@ def test_a_rough_rival_better_than_the_name_is_noted():
     assert rough_rivals(rnd) == [] and rough_notes(rnd, 1) == []
     s.sampled, best.delta_log_evidence = True, 37.5  # judged on its importance draws
     assert rough_rivals(rnd) == []
+
+
+def test_the_headline_names_the_candidates_that_could_not_be_sampled():
+    """One rough candidate is said in the singular, several in the plural."""
+    from dataclasses import replace
+
+    from harvester.diagnosis.verdict import Conclusion, FitJudgement, headline
+    found = Conclusion("missing_physics", [], [], True, [], None, True)
+    fit = FitJudgement(0.9, 0.3, "holdout", 1.0, None, None)
+    one = headline("missing_physics", replace(found, unsampled=["stribeck_friction"]), fit,
+                   "linear", 3.0)
+    assert "stribeck_friction fits better at its best fit but could not be sampled (its " \
+        "likelihood jumps)" in one
+    two = headline("missing_physics", replace(found, unsampled=["quadratic_damping",
+                                                                "unmodelled_mode"]),
+                   fit, "linear", 3.0)
+    assert "quadratic_damping, unmodelled_mode fit better at their best fits but could not " \
+        "be sampled (their likelihoods jump)" in two

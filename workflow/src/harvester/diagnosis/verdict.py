@@ -357,8 +357,11 @@ def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
         parts.append(f"no library name: {', '.join(found.withheld)} lack the missing force's "
                      "shape")
     if found.unsampled:
-        parts.append(f"{', '.join(found.unsampled)} fits better at its best fit but could not "
-                     "be sampled (its likelihood jumps)")
+        one = len(found.unsampled) == 1
+        parts.append(f"{', '.join(found.unsampled)} "
+                     + ("fits better at its best fit but could not be sampled (its likelihood "
+                        "jumps)" if one else "fit better at their best fits but could not be "
+                        "sampled (their likelihoods jump)"))
     share = fit.library_share()
     if verdict != "adequate":
         parts.append(_library_phrase(share, found.accepted))
