@@ -288,16 +288,11 @@ def smoother_response(dev: _Device, kernel: str, length: float, amp: float, nois
     (docs/latent-force.md)."""
     disc, H, D, R, m0, P0, T = _model(dev, kernel, length, amp, noise)
     n, out = len(dev.y), np.zeros(len(dev.y))
+    pulse = _pulse_output(disc, H, D, n, centre)
     phases = [p for p in range(dev.stride) if centre + p + 1 < n]
-    for phase in phases:
-        j = centre + phase
-        x = np.zeros((n, len(m0)))
-        x[j] = -disc.G1  # a force f enters eq. (1) as a drive of -f
-        x[j + 1] = disc.Phi @ x[j] - disc.G0
-        for k in range(j + 1, n - 1):
-            x[k + 1] = disc.Phi @ x[k]
-        y = x @ H
-        y[j] -= D
+    for phase in phases:  # the pulse one sample later each time, the measurements fixed
+        y = np.zeros(n)
+        y[phase:] = pulse[:n - phase]
         mf, Pf, mp, Pp, _ = kalman_filter(disc.Phi, disc.G0, disc.G1, disc.Q, H, D, R,
                                           np.zeros(n), y, _measured(dev), np.zeros(len(m0)),
                                           P0)
@@ -308,11 +303,26 @@ def smoother_response(dev: _Device, kernel: str, length: float, amp: float, nois
     return out[centre - half:centre + half + 1]
 
 
+def _pulse_output(disc: Discrete, H: np.ndarray, D: float, n: int, j: int) -> np.ndarray:
+    """The noise-free output (``n`` samples) of the device alone (the process's and the
+    noise's states at rest) to a one-sample force pulse of 1 N at sample ``j``: a force f
+    enters eq. (1) as a drive of -f, through the same first-order hold as the drive."""
+    x = np.zeros((n, len(disc.G0)))
+    x[j] = -disc.G1
+    if j + 1 < n:
+        x[j + 1] = disc.Phi @ x[j] - disc.G0
+    for k in range(j + 1, n - 1):
+        x[k + 1] = disc.Phi @ x[k]
+    y = x @ H
+    y[j] -= D
+    return y
+
+
 def through_response(x: np.ndarray, response: np.ndarray | None) -> np.ndarray:
     """``x`` (samples along the last axis) through the smoother's response (centred)."""
-    if response is None or response.size == 1 and response[0] == 1.0:
-        return np.asarray(x, dtype=float)
     x = np.asarray(x, dtype=float)
+    if response is None:
+        return x
     half = response.size // 2
     full = signal.fftconvolve(x, response.reshape((1,) * (x.ndim - 1) + (-1,)), axes=-1)
     return full[..., half:half + x.shape[-1]]

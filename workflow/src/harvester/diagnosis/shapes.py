@@ -521,9 +521,9 @@ def _moving_mean(x: np.ndarray, width: int) -> np.ndarray:
     return np.convolve(x, np.ones(width) / width, mode="same")
 
 
-def determined(lf: LatentForce) -> tuple[LatentForce, Callable, Callable]:
-    """(the latent force seen through its determined band, that band's filter, the filter's
-    mask alone, for a force already through the latent force's band): the
+def determined(lf: LatentForce) -> tuple[LatentForce, Callable]:
+    """(the latent force whose ``band`` passes a shape's bases through its determined band,
+    that band's mask alone, for a force already through the latent force's band): the
     frequencies where the force's posterior mean stands out of its draws' spread (smoothed
     power of the mean above that of the draws' deviations, SIGNAL_RATIO), the rest removed
     from the force and from every shape's bases (zero-padded FFT; after the likelihood's
@@ -532,7 +532,7 @@ def determined(lf: LatentForce) -> tuple[LatentForce, Callable, Callable]:
     mean's power lay at 0.5-2 Hz, with the draws' spread as large, and the line found was
     0.87 Hz; in the determined band it is 50.0 Hz, 0.88 N. Without draws: unchanged."""
     if lf.draws.ndim != 2 or lf.draws.shape[0] < 2:
-        return lf, lf.band, _unfiltered
+        return lf, _unfiltered
     n = lf.force.size
     nfft = 2 * n
     spread = np.mean(np.abs(np.fft.rfft(lf.draws - lf.force, nfft, axis=1)) ** 2, axis=0)
@@ -540,7 +540,7 @@ def determined(lf: LatentForce) -> tuple[LatentForce, Callable, Callable]:
     keep = (_moving_mean(power, DETERMINED_BINS)
             > SIGNAL_RATIO * _moving_mean(spread, DETERMINED_BINS)).astype(float)
     if keep.all():
-        return lf, lf.band, _unfiltered
+        return lf, _unfiltered
     band = lf.band
 
     def mask(x: np.ndarray) -> np.ndarray:
@@ -551,7 +551,7 @@ def determined(lf: LatentForce) -> tuple[LatentForce, Callable, Callable]:
 
     seen = copy.copy(lf)
     seen.band = through  # the shapes read the band from here (an instance attribute)
-    return seen, through, mask
+    return seen, mask
 
 
 def describe(lf: LatentForce, dictionary=DICTIONARY) -> ShapeDescription:
@@ -561,7 +561,7 @@ def describe(lf: LatentForce, dictionary=DICTIONARY) -> ShapeDescription:
     explains SHARE_MARGIN more; a shape of the slow part, :func:`slow_shapes`, only if every
     shape is one), and the sentence (sizes in ``lf.units``)."""
     offset = float(np.mean(lf.force))
-    seen, _, mask = determined(lf)
+    seen, mask = determined(lf)
     f = mask(lf.force - offset)  # the force is in its band already; the bases go through it
     fitted = [shape(seen, f) for shape in dictionary]
     if not any(is_friction(t) for t in structure(lf.baseline).layout.terms):
