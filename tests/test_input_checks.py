@@ -445,3 +445,40 @@ def test_reader_returns_the_warnings_and_the_sidecar(valid, tmp_path):
     assert checked.sidecar.known == TABLE1_KNOWN and checked.sidecar.filtered_at_hz == 20.0
     assert [w.check for w in checked.warnings] == ["saturation"]
     assert "r.csv, line" in str(checked.warnings[0])
+
+
+def _two_accelerometers(seconds: float = 60.0, fs: float = 256.0, seed: int = 3):
+    """A linear device (M 10 kg, m 3 kg, f_n 1.5 Hz, 5 % damping) shaken over 0.3-5 Hz
+    (2 m/s^2 RMS), rel_acc formed as the mass's accelerometer minus the base's, each with
+    0.05 m/s^2 of white noise: beyond 5 Hz the base channel holds its noise alone, and
+    rel_acc holds the same noise with gain -1. Synthesised in the frequency domain (periodic,
+    no start-up)."""
+    rng = np.random.default_rng(seed)
+    n = int(seconds * fs)
+    f = np.fft.rfftfreq(n, 1.0 / fs)
+    spec = np.where((f > 0.3) & (f < 5.0), np.exp(2j * np.pi * rng.uniform(size=f.size)), 0)
+    y = np.fft.irfft(spec, n)
+    y *= 2.0 / np.std(y)
+    M, m, k = 10.0, 3.0, 10.0 * (2 * np.pi * 1.5) ** 2
+    w = 2 * np.pi * f
+    z = np.fft.irfft(np.fft.rfft(y) * m * w**2 / (k - M * w**2 + 2j * 0.05 * np.sqrt(k * M) * w),
+                     n)
+    base_noise, mass_noise = 0.05 * rng.standard_normal((2, n))
+    df = pd.DataFrame({"time": np.arange(n) / fs, "base_acc": y + base_noise,
+                       "rel_acc": z + mass_noise - base_noise})
+    return df, {"M": M, "m": m, "k": k}
+
+
+def test_a_base_sensors_noise_shared_by_rel_acc_is_not_a_unit_slip():
+    """Beyond the excitation's band the coherent FRF lines hold the base sensor's noise at
+    gain 1, above the device's m/M = 0.3: the record is read with a warning that says so (it
+    was refused as a unit slip); a slip by g on the same record is still refused."""
+    df, known = _two_accelerometers()
+    kinds = RecordingKinds("base_acc", "rel_acc")
+    g = checks.gain_above_resonance(df, kinds, 1 / 256.0, known)
+    assert g["ratio"] > checks.UNIT_RATIO and g["ratio_ceiling"] < checks.UNIT_RATIO
+    found = checks.check_units_by_physics(df, kinds, 1 / 256.0, known, "r")
+    assert len(found) == 1 and "the base sensor's own noise" in str(found[0])
+    with pytest.raises(DataError, match="factor g"):
+        checks.check_units_by_physics(df.assign(base_acc=df.base_acc / G), kinds, 1 / 256.0,
+                                      known, "r")
