@@ -604,8 +604,8 @@ def standing(shape: Shape, spread: np.ndarray | None) -> float:
     samples each lie within their sd can still hold a shape the record determines, summed
     over thousands of samples: on the literature generator's records of forms outside the
     library the right shape stood 13.8-52 sd out (mains hum, friction drifts, quadratic
-    springs, cogging of seed 1), while on its effect-free records no shape stood more than
-    6.1 sd out (docs/latent-force.md). NaN without draws (nothing to stand out of)."""
+    springs, cogging of seed 1), while on twelve effect-free records of its grid no shape stood
+    more than 7.6 sd out (docs/latent-force.md). NaN without draws (nothing to stand out of)."""
     norm = float(np.linalg.norm(shape.fitted))
     if spread is None:
         return float("nan")
@@ -619,7 +619,7 @@ def _one_dof(s: float, dof: int) -> float:
     """The standing ``s`` of a fit with ``dof`` free coefficients as the one coefficient's
     standing of the same tail probability. Fitted to noise alone, k coefficients give a
     norm^2 of about sd^2 chi^2_k, so s^2 is referred to chi^2_k: a stick-slip fit with a
-    constant for each of 77 stick phases stood 13.5 sd out on an effect-free record (6.1
+    constant for each of 77 stick phases stood 13.5 sd out on an effect-free record (6.2
     referred to its 81 coefficients); a scanned parameter counts as one coefficient. s
     itself for one, or where the tail underflows (s above about 38)."""
     if dof <= 1 or not np.isfinite(s):
