@@ -119,6 +119,9 @@ class LatentForce:
     units: Units = SI
     #: the smoother's response W (``smoother_response``), None: the identity
     response: np.ndarray | None = field(repr=False, default=None)
+    #: the recording less the smoother's output (the baseline's dynamics under the posterior
+    #: mean force), in the output's unit: its noise and what the force model cannot hold
+    output_residual: np.ndarray = field(repr=False, default_factory=lambda: np.empty(0))
 
     @property
     def lower(self) -> np.ndarray:
@@ -406,6 +409,15 @@ def _force_scale(dev: _Device, residual: np.ndarray) -> float:
     return max(gain * float(np.std(residual)), 1e-6)
 
 
+def _smoothed_output(dev: _Device, kernel: str, length: float, amp: float, noise: float,
+                     mean: np.ndarray) -> np.ndarray:
+    """The output the smoothed states give (output's unit): the device's measurement of
+    (z, z', g) and the drive's feedthrough, without the chain's noise states."""
+    _, H, D, _, _, _, T = _model(dev, kernel, length, amp, noise)
+    n = 2 + MATERN_STATES[kernel]
+    return (mean[:, :n] / T[:n]) @ H[:n] + D * dev.drive
+
+
 def _paths(dev: _Device, disc, T, filtered, draws: int, seed: int):
     """Smoothed means (samples, states) and joint draws of the state path (draws, samples,
     states), in SI units."""
@@ -495,7 +507,9 @@ def latent_force(state: BaselineState, window: tuple[int, int] | None = None, *,
         noise_in_band=dev.noise is not None,
         seconds=time.perf_counter() - clock, filter_order=int(getattr(p, "filter_order", 8)),
         draws=f_paths[:, w], state_draws=states[..., w], lead_draws=states[..., :start],
-        lead_input=dev.input[:start], units=units, response=response)
+        lead_input=dev.input[:start], units=units, response=response,
+        output_residual=(dev.y - _smoothed_output(dev, kernel, length, amp, noise_sd,
+                                                  mean))[w])
     unit = units.label("force")
     log.info("latent force of %s: RMS %.3g %s (sd %.2g %s), length scale %.3g s, noise %.3g "
              "(baseline's sigma %.3g), %.1f s", p.structure.name, out.rms_N, unit,

@@ -1,7 +1,7 @@
 """The missing force in one call, for the diagnosis run and its diagnosis.json: the latent force
 of the baseline (``latent``), its shape (``shapes``), its views (``latent_views``), each named
-effect's force beside it with its size and relevance (``relevance``), and the figures
-(``latent_figures``)."""
+effect's force beside it with its size and relevance (``relevance``), a line the force leaves
+in the recording (``lines``), and the figures (``latent_figures``)."""
 
 from __future__ import annotations
 
@@ -15,6 +15,7 @@ from harvester.data.units import SI, Units
 from harvester.diagnosis.baseline import BaselineState
 from harvester.diagnosis.latent import LatentForce, latent_force
 from harvester.diagnosis.latent_views import Binned, EffectForce, effect_force, views
+from harvester.diagnosis.lines import ResidualLine, residual_line
 from harvester.diagnosis.relevance import (EffectSize, RelevanceFloor, effect_size,
                                            response_change, ridge, term_force_rms)
 from harvester.diagnosis.shapes import ShapeDescription, describe
@@ -47,6 +48,8 @@ class MissingForce:
     effects: list[EffectForce] = field(default_factory=list)
     sizes: list[EffectSize] = field(default_factory=list)
     figure_files: list[str] = field(default_factory=list)
+    #: a sensor's or the acquisition's line the force leaves in the recording (``lines``)
+    residual_line: ResidualLine | None = None
 
     def to_dict(self) -> dict:
         """diagnosis.json's ``missing_force`` entry."""
@@ -55,7 +58,9 @@ class MissingForce:
                 "views": {k: v.to_dict() for k, v in self.views.items()},
                 "named_effects": [{**ef.to_dict(), **size.to_dict()}
                                   for ef, size in zip(self.effects, self.sizes)],
-                "figures": self.figure_files}
+                "figures": self.figure_files,
+                "residual_line": (None if self.residual_line is None
+                                  else self.residual_line.to_dict())}
 
 
 def missing_force(state: BaselineState, window: tuple[int, int] | None = None,
@@ -69,7 +74,7 @@ def missing_force(state: BaselineState, window: tuple[int, int] | None = None,
     of every size, ``data.units``); figures in ``out_dir`` if given."""
     lf = latent_force(state, window, units=units, **latent_kwargs)
     desc = describe(lf)
-    out = MissingForce(lf, desc, views(lf))
+    out = MissingForce(lf, desc, views(lf), residual_line=residual_line(lf))
     for effect in named:
         ef = effect_force(lf, effect.structure, effect.theta, state.problem.known, effect.term)
         response = None

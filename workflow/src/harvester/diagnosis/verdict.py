@@ -291,6 +291,8 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
     if verdict == "adequate" and missing is not None and missing.description.readable:
         notes.append("below the verdict's bar, the missing force still stands out of its "
                      f"uncertainty: {missing.description.sentence}")
+    if missing is not None and missing.residual_line is not None:
+        notes.append(missing.residual_line.sentence())
     if fit.floor is None:
         notes.append("no noise floor of the recording's own could be measured (no repeated "
                      "periods, quiet lead-in or white band): the verdict rests on the "
