@@ -113,8 +113,8 @@ def residual_line(lf: LatentForce) -> ResidualLine | None:
     x, sd = _ratios(r)
     dt = float(lf.time[1] - lf.time[0])
     freqs = np.fft.rfftfreq(r.size, dt)
-    tested = ((np.arange(x.size) > NEIGHBOURS + GUARD)
-              & (freqs < EDGE * min(lf.band_hz, 0.5 / dt)))
+    top = min(lf.band_hz, 0.5 / dt) if np.isfinite(lf.band_hz) else 0.5 / dt
+    tested = (np.arange(x.size) > NEIGHBOURS + GUARD) & (freqs < EDGE * top)
     inp = np.asarray(lf.input, dtype=float)
     if inp.size == r.size and np.ptp(inp) > 0:
         x_in, sd_in = _ratios(inp)
