@@ -451,3 +451,14 @@ def test_a_shapes_standing_on_noise_is_referred_to_its_coefficients():
     assert np.quantile(referred, 0.95) == pytest.approx(1.96, abs=0.35)
     one = Shape("test", 0.0, {}, "", basis[:, 0] * 12.0, dof=1)
     assert standing(one, rng.standard_normal((200, n))) == pytest.approx(12.0, rel=0.15)
+
+
+def test_an_unread_force_says_when_z_itself_is_unknown():
+    """Nothing read on a motion of 0.7 mm RMS: with z known to 1 um no more is said; known
+    to 1 mm only (an acceleration record of a small motion), the sentence says that a force
+    varying with z on a finer scale cannot be read."""
+    lf = _noisy_latent(0.0)
+    assert "z itself" not in describe(lf).sentence
+    vague = describe(dataclasses.replace(lf, disp_sd=np.full(lf.time.size, 1e-3)))
+    assert not vague.readable
+    assert "z itself is known to +-1 mm only (RMS 0.71 mm)" in vague.sentence
