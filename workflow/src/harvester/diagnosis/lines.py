@@ -35,7 +35,7 @@ from harvester.diagnosis.latent import LatentForce
 
 #: Family-wise false-alarm rate over the bins tested.
 LINE_ALPHA = 1e-3
-#: Bins on each side of a bin whose median sets its local level, beyond GUARD.
+#: Bins on each side of a bin whose mean log power sets its local level, beyond GUARD.
 NEIGHBOURS = 64
 #: Bins on each side of a line held by its own leakage (Hann: the main lobe is +-2 bins).
 GUARD = 3
