@@ -93,3 +93,24 @@ def test_a_residual_the_smoother_cannot_carry_is_not_called_no_missing_force():
     lf.noise_sd = 1.8e-4
     assert not latent_unread(missing, far, 3.0)
     assert "no missing force" in headline("missing_physics", found, far, "linear", 3.0, missing)
+
+
+def test_one_named_effect_is_sized_by_its_own_force_in_the_headline():
+    """A named end stop whose force along the smoothed states (9.97 N, impacts where the
+    states are uncertain by millimetres) is 53 x its own along its own response (0.189 N):
+    the headline gives its own force with its interval and share of the drive; two effects
+    together keep the force beyond the baseline's."""
+    from types import SimpleNamespace
+
+    from harvester.diagnosis.relevance import EffectSize, RelevanceFloor
+    from harvester.diagnosis.verdict import _named
+    size = EffectSize("end_stop", 9.97, 3.71, 0.0, None, None, False, RelevanceFloor(),
+                      term_rms_N=0.189, term_rms_interval_N=(0.128, 0.202))
+    found = SimpleNamespace(named_fit=None, improved_fit=None, missing=["end_stop"], ties=[])
+    said = _named(found, SimpleNamespace(sizes=[size]))
+    assert said == ("end_stop (its own force 0.189 N RMS, 95 % 0.128-0.202, 7.03% of the "
+                    "drive, relevant)")
+    two = _named(SimpleNamespace(named_fit=None, improved_fit=None,
+                                 missing=["end_stop", "cubic_stiffness"], ties=[]),
+                 SimpleNamespace(sizes=[size, size]))
+    assert "(together 9.97 N RMS, 371.00% of the drive, relevant)" in two

@@ -89,6 +89,13 @@ class EffectSize:
     def label(self) -> str:
         return "detectable but negligible" if self.negligible else "relevant"
 
+    @property
+    def own_share_of_drive(self) -> float | None:
+        """The term's own force (median RMS) over the drive's RMS, None without it."""
+        if self.term_rms_N is None or self.force_rms_N <= 0.0:
+            return None
+        return self.term_rms_N * self.share_of_drive / self.force_rms_N
+
     def sentence(self) -> str:
         text = (f"{self.term}: {self.force_rms_N:.3g} {self.units.label('force')} RMS "
                 f"({100 * self.share_of_drive:.2g} % of the drive), explains "

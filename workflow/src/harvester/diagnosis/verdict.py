@@ -319,9 +319,13 @@ def _level(effect: str, fit: ModelFit | None, units: Units = SI) -> str:
 
 
 def _named(found: Conclusion, missing: MissingForce | None, units: Units = SI) -> str:
-    """The effects named and tied, with their size where the missing force gave it. The size
-    is the improved model's force beyond the baseline's (``latent_views.effect_force``): with
-    several effects added it is theirs together, and said once (labelled in ``units``). A
+    """The effects named and tied, with their size where the missing force gave it. One
+    effect's size is its term's own force along its own simulated response, with its 95 %
+    interval (``relevance.term_force_rms``); several effects' (or one without that) is the
+    improved model's force beyond the baseline's along the smoothed states
+    (``latent_views.effect_force``), theirs together, said once. Along states uncertain by
+    millimetres an impact term's force is not its own: a named end stop read 9.97 N RMS
+    there (371 % of the drive) and 0.189 N along its own response. Labelled in ``units``; a
     named effect's strength is read from the last round that named one (``named_fit``)."""
     fit = found.named_fit or found.improved_fit
     groups = [" / ".join(g) for g in [[_level(e, fit, units)] for e in found.missing]
@@ -329,9 +333,13 @@ def _named(found: Conclusion, missing: MissingForce | None, units: Units = SI) -
     sizes = missing.sizes if missing is not None else []
     if not sizes:
         return ", ".join(groups)
-    s = sizes[0]
+    s, force = sizes[0], units.label("force")
+    if len(sizes) == 1 and s.own_share_of_drive is not None and s.term_rms_interval_N:
+        lo, hi = s.term_rms_interval_N
+        return (", ".join(groups) + f" (its own force {s.term_rms_N:.3g} {force} RMS, 95 % "
+                f"{lo:.3g}-{hi:.3g}, {s.own_share_of_drive:.2%} of the drive, {s.label})")
     together = "together " if len(sizes) > 1 else ""
-    return (", ".join(groups) + f" ({together}{s.force_rms_N:.3g} {units.label('force')} "
+    return (", ".join(groups) + f" ({together}{s.force_rms_N:.3g} {force} "
             f"RMS, {s.share_of_drive:.2%} of the drive, {s.label})")
 
 
