@@ -105,7 +105,8 @@ def test_one_named_effect_is_sized_by_its_own_force_in_the_headline():
     from harvester.diagnosis.relevance import EffectSize, RelevanceFloor
     from harvester.diagnosis.verdict import _named
     size = EffectSize("end_stop", 9.97, 3.71, 0.0, None, None, False, RelevanceFloor(),
-                      term_rms_N=0.189, term_rms_interval_N=(0.128, 0.202))
+                      term_rms_N=0.189, term_rms_interval_N=(0.128, 0.202),
+                      drive_rms_N=9.97 / 3.71)
     found = SimpleNamespace(named_fit=None, improved_fit=None, missing=["end_stop"], ties=[])
     said = _named(found, SimpleNamespace(sizes=[size]))
     assert said == ("end_stop (its own force 0.189 N RMS, 95 % 0.128-0.202, 7.03% of the "

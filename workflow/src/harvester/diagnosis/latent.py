@@ -269,10 +269,12 @@ def _measured(dev: _Device) -> np.ndarray:
 
 
 def _filter(dev: _Device, kernel: str, length: float, amp: float, noise: float):
+    """(the Kalman filter's output, the discrete model, its measurement row H and
+    feedthrough D, the states' scales T)."""
     disc, H, D, R, m0, P0, T = _model(dev, kernel, length, amp, noise)
     out = kalman_filter(disc.Phi, disc.G0, disc.G1, disc.Q, H, D, R, dev.drive, dev.y,
                         _measured(dev), m0, P0)
-    return out, disc, T
+    return out, disc, H, D, T
 
 
 #: The smoother's response is kept out to where it falls below this share of its peak.
@@ -409,11 +411,11 @@ def _force_scale(dev: _Device, residual: np.ndarray) -> float:
     return max(gain * float(np.std(residual)), 1e-6)
 
 
-def _smoothed_output(dev: _Device, kernel: str, length: float, amp: float, noise: float,
+def _smoothed_output(dev: _Device, kernel: str, H: np.ndarray, D: float, T: np.ndarray,
                      mean: np.ndarray) -> np.ndarray:
-    """The output the smoothed states give (output's unit): the device's measurement of
-    (z, z', g) and the drive's feedthrough, without the chain's noise states."""
-    _, H, D, _, _, _, T = _model(dev, kernel, length, amp, noise)
+    """The output the smoothed states ``mean`` (SI) give through the model's ``H``, ``D``
+    and scales ``T`` (output's unit): the device's measurement of (z, z', g) and the
+    drive's feedthrough, without the chain's noise states."""
     n = 2 + MATERN_STATES[kernel]
     return (mean[:, :n] / T[:n]) @ H[:n] + D * dev.drive
 
@@ -488,7 +490,7 @@ def latent_force(state: BaselineState, window: tuple[int, int] | None = None, *,
         sigma_b if noise == "baseline" else float(noise)), noise_floor)
     length, amp, noise_sd, logml = fit_hyperparameters(
         dev, kernel, _force_scale(dev, residual[start:stop]), fixed or sigma_b, fixed is None)
-    filtered, disc, T = _filter(dev, kernel, length, amp, noise_sd)
+    filtered, disc, H, D, T = _filter(dev, kernel, length, amp, noise_sd)
     mean, paths = _paths(dev, disc, T, filtered, draws, seed)
     response = smoother_response(dev, kernel, length, amp, noise_sd, (start + stop) // 2)
     force, f_paths, terms_mean = _forces(state, dev, mean, paths, response)
@@ -508,8 +510,7 @@ def latent_force(state: BaselineState, window: tuple[int, int] | None = None, *,
         seconds=time.perf_counter() - clock, filter_order=int(getattr(p, "filter_order", 8)),
         draws=f_paths[:, w], state_draws=states[..., w], lead_draws=states[..., :start],
         lead_input=dev.input[:start], units=units, response=response,
-        output_residual=(dev.y - _smoothed_output(dev, kernel, length, amp, noise_sd,
-                                                  mean))[w])
+        output_residual=(dev.y - _smoothed_output(dev, kernel, H, D, T, mean))[w])
     unit = units.label("force")
     log.info("latent force of %s: RMS %.3g %s (sd %.2g %s), length scale %.3g s, noise %.3g "
              "(baseline's sigma %.3g), %.1f s", p.structure.name, out.rms_N, unit,

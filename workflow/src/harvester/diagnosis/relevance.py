@@ -79,6 +79,8 @@ class EffectSize:
     ridge: tuple[str, float] | None = None
     #: whether the interval's posterior was adjusted for correlated residuals
     interval_adjusted: bool = False
+    #: RMS of the drive (m y'' or F) the shares of the drive are of
+    drive_rms_N: float | None = None
 
     @property
     def explains(self) -> float:
@@ -91,10 +93,10 @@ class EffectSize:
 
     @property
     def own_share_of_drive(self) -> float | None:
-        """The term's own force (median RMS) over the drive's RMS, None without it."""
-        if self.term_rms_N is None or self.force_rms_N <= 0.0:
+        """The term's own force (median RMS) over the drive's RMS, None without either."""
+        if self.term_rms_N is None or not self.drive_rms_N:
             return None
-        return self.term_rms_N * self.share_of_drive / self.force_rms_N
+        return self.term_rms_N / self.drive_rms_N
 
     def sentence(self) -> str:
         text = (f"{self.term}: {self.force_rms_N:.3g} {self.units.label('force')} RMS "
@@ -222,11 +224,12 @@ def effect_size(lf: LatentForce, ef: EffectForce, floor: RelevanceFloor = Releva
     the shapes read theirs, its own force's RMS (:func:`term_force_rms`) and the ridge its
     strength lies on (:func:`ridge`), and whether that interval's posterior was adjusted for
     correlated residuals (``adjusted``); labelled in ``lf.units``."""
-    share = ef.rms_N / drive_rms(lf)
+    drive = drive_rms(lf)
+    share = ef.rms_N / drive
     small_response = response is None or response[1] < floor.response_share
     negligible = floor.enabled and share < floor.force_share and small_response
     return EffectSize(ef.term, ef.rms_N, share, ef.share,
                       None if response is None else response[0],
                       None if response is None else response[1], negligible, floor, lf.units,
                       share_of_missing, None if term_rms is None else term_rms[0],
-                      None if term_rms is None else term_rms[1:], on_ridge, adjusted)
+                      None if term_rms is None else term_rms[1:], on_ridge, adjusted, drive)
