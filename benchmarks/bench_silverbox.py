@@ -15,11 +15,14 @@ and runs, each timed by the wall clock:
 then simulates each model's posterior (``SAMPLES`` thinned rows, their predictive mean) from
 rest for the input alone over the fitted samples and the ``--held-samples`` after them, and
 prints the RMS error in mV on those held-out samples
-(``harvester.inference.unseen.heldout_error``), then the benchmark's own test sets
-(``harvester.data.public.SILVERBOX_BENCHMARK_TESTS``), on which published errors are taken,
-and the publications that report such errors (``PUBLISHED``). No published number is
-printed: none was retrieved with its source text when this was written (issue 41), and
-none is quoted from memory.
+(``harvester.inference.unseen.heldout_error``).
+
+With ``--benchmark`` the same is done on the benchmark's own record, SNLS80mV.mat, as the
+benchmark cuts it (``harvester.data.public.silverbox_benchmark``): fitted on the first
+``--fit-samples`` of its training multisine, each model simulated for each test's input
+alone, its RMS error (mV) after the first ``SILVERBOX_INIT`` samples printed beside the
+published errors on the same tests that were read in their sources
+(``harvester.study.benchmark.benchmark_table``; none is quoted from memory).
 """
 
 from __future__ import annotations
@@ -34,20 +37,10 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 SILVERBOX = ROOT / "data" / "public" / "silverbox" / "Schroeder80mV.mat"
+BENCHMARK = SILVERBOX.with_name("SNLS80mV.mat")
 MODELS = ("linear", "linear+cubic_stiffness")
 #: Posterior rows simulated for the held-out predictive mean.
 SAMPLES = 100
-#: Publications with Silverbox test errors (RMS, mV) on the benchmark's test sets; their
-#: numbers are to be read from the papers themselves.
-PUBLISHED = (
-    "T. Wigren and J. Schoukens, Three free data sets for development and benchmarking in "
-    "nonlinear system identification, ECC 2013, pp. 2933-2938 (the benchmark)",
-    "M. D. Champneys, G. I. Beintema, R. Toth, M. Schoukens and T. J. Rogers, Baseline "
-    "results for selected nonlinear system identification benchmarks, arXiv:2405.10779 "
-    "(2024): ten baselines and selected state-of-the-art results on Silverbox's tests",
-    "D. Khandelwal, M. Schoukens and R. Toth, Grammar-based representation and "
-    "identification of dynamical systems, arXiv:1811.10576 (2018): Silverbox beside "
-    "state-of-the-art methods")
 
 
 def _run(args: list[str], cwd: Path) -> float:
@@ -95,28 +88,38 @@ def heldout_mv(idata, held) -> dict:
     return {**err, "rms_error_mV": 1e3 * err["rms_error"], "rms_output_mV": 1e3 * err["rms_output"]}
 
 
-def _print(held, diag: dict | None, cmp: dict, errors: dict) -> None:
-    from harvester.data.public import SILVERBOX_BENCHMARK_TESTS, SILVERBOX_FS
-    fit_s = len(held.fit.data) / SILVERBOX_FS
+def _print_heldout(held, errors: dict) -> None:
+    from harvester.data.public import SILVERBOX_FS
     a, b = held.section
-    print(f"Silverbox Schroeder80mV: fitted on {fit_s:.2f} s; held out {(b - a) / SILVERBOX_FS:.2f}"
-          f" s after it (samples {a}-{b} of the record read from the multisine's start)")
+    print(f"Silverbox Schroeder80mV: fitted on {len(held.fit.data) / SILVERBOX_FS:.2f} s; held "
+          f"out {(b - a) / SILVERBOX_FS:.2f} s after it (samples {a}-{b} from the multisine's "
+          "start)")
+    for m, e in errors.items():
+        print(f"  {m:24s} held-out RMS error {e['rms_error_mV']:.3f} mV (output RMS "
+              f"{e['rms_output_mV']:.1f} mV, NRMSE {e['nrmse']:.4f})")
+
+
+def _print_benchmark(split, cmp: dict) -> None:
+    from harvester.data.public import SILVERBOX_FS, SILVERBOX_INIT
+    from harvester.study.benchmark import benchmark_table
+    table = benchmark_table({m: r["idata"] for m, r in cmp["models"].items()}, split, SAMPLES)
+    n = len(split.fit.data)
+    print(f"Silverbox benchmark (SNLS80mV.mat): fitted on the training multisine's first {n} "
+          f"samples ({n / SILVERBOX_FS:.2f} s); RMS error (mV) on each test after its first "
+          f"{SILVERBOX_INIT} samples, simulated for its input alone:")
+    print(table.drop(columns="source").to_string(index=False,
+                                                 float_format=lambda x: f"{x:.3f}"))
+    for _, r in table[table["source"] != "this study"].iterrows():
+        print(f"  {r['model']}: {r['source']}")
+
+
+def _print(diag: dict | None, cmp: dict) -> None:
     if diag is not None:
         print(f"diagnose --baseline linear: {diag['verdict']}, named {diag['missing']}, "
               f"{diag['seconds']:.0f} s")
     print(f"compare {' '.join(MODELS)}: {cmp['seconds']:.0f} s")
     for m, r in cmp["models"].items():
-        e = errors[m]
-        print(f"  {m:24s} log evidence {r['log_evidence']:10.2f}  TMCMC {r['tmcmc_s']:5.0f} s  "
-              f"held-out RMS error {e['rms_error_mV']:.3f} mV (output RMS "
-              f"{e['rms_output_mV']:.1f} mV, NRMSE {e['nrmse']:.4f})")
-    print("published: no figure quoted (none retrieved with its source). Published errors "
-          "are on the benchmark's test sets, not on these held-out samples of another record:")
-    for test in SILVERBOX_BENCHMARK_TESTS:
-        print(f"  - {test}")
-    print("reported in:")
-    for ref in PUBLISHED:
-        print(f"  - {ref}")
+        print(f"  {m:24s} log evidence {r['log_evidence']:10.2f}  TMCMC {r['tmcmc_s']:5.0f} s")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -125,21 +128,32 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--fit-samples", type=int, default=4883, help="samples fitted (4883: 8 s)")
     p.add_argument("--held-samples", type=int, default=4883, help="held-out samples (4883)")
     p.add_argument("--skip-diagnose", action="store_true", help="time the compare only")
+    p.add_argument("--benchmark", action="store_true",
+                   help="fit and test on SNLS80mV.mat as the benchmark cuts it")
     args = p.parse_args(argv)
-    if not SILVERBOX.is_file():
-        print(f"skipped: {SILVERBOX} is absent (the Silverbox recording, see "
-              "data/public/silverbox/SOURCE.md)")
+    source = BENCHMARK if args.benchmark else SILVERBOX
+    if not source.is_file():
+        print(f"skipped: {source} is absent (see data/public/silverbox/SOURCE.md)")
         return 0
-    from harvester.data.public import silverbox_heldout
-    held = silverbox_heldout(SILVERBOX, args.fit_samples, args.held_samples)
+    from harvester.data import public
+    if args.benchmark:
+        split = public.silverbox_benchmark(source, args.fit_samples)
+        fit = split.fit
+    else:
+        held = public.silverbox_heldout(source, args.fit_samples, args.held_samples)
+        fit = held.fit
     with tempfile.TemporaryDirectory() as tmp:
         work = args.out or Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
-        rec = held.fit.write(work / "silverbox.csv")
+        rec = fit.write(work / "silverbox.csv")
         diag = None if args.skip_diagnose else diagnose(rec, work / "diagnosis")
         cmp = compare(rec, work / "compare")
-        errors = {m: heldout_mv(r["idata"], held) for m, r in cmp["models"].items()}
-        _print(held, diag, cmp, errors)
+        _print(diag, cmp)
+        if args.benchmark:
+            _print_benchmark(split, cmp)
+        else:
+            _print_heldout(held, {m: heldout_mv(r["idata"], held)
+                                  for m, r in cmp["models"].items()})
     return 0
 
 

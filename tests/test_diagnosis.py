@@ -59,6 +59,31 @@ def test_filter_cutoff_finds_a_preprocessing_lowpass_and_nothing_else():
         assert found is not None and 0.85 * cut < found <= 1.02 * cut
 
 
+def test_a_low_pass_given_as_none_is_not_looked_for_and_a_shared_roll_off_is_noted(tmp_path):
+    """``recording_lowpass``: a given cut-off is kept, 0 means none (nothing looked for), None
+    looks; ``shared_roll_off`` notes an input falling where the output's low-pass was found
+    (an excitation's band edge looks like a filter in both channels), not an input falling two
+    octaves higher; a sidecar may say ``filtered_at_hz: 0``, not a negative cut-off."""
+    from harvester.data.errors import DataError
+    from harvester.data.sidecar import read_sidecar
+    from harvester.diagnosis.spectral import recording_lowpass, shared_roll_off
+    rng = np.random.default_rng(1)
+    u, y = rng.standard_normal((2, 20 * 256))
+    y20 = lowpass(y, FS, 20.0, 8)
+    found = recording_lowpass(None, y20, FS)
+    assert found is not None and 17.0 < found <= 20.4
+    assert recording_lowpass(0.0, y20, FS) is None and recording_lowpass(25.0, y20, FS) == 25.0
+    note = shared_roll_off(lowpass(u, FS, 20.0, 8), found, FS)
+    assert note is not None and "filtered_at_hz: 0" in note
+    assert shared_roll_off(lowpass(u, FS, 80.0, 8), found, FS) is None
+    assert shared_roll_off(u, None, FS) is None
+    (tmp_path / "r.yaml").write_text("filtered_at_hz: 0\n")
+    assert read_sidecar(tmp_path / "r.csv").filtered_at_hz == 0.0
+    (tmp_path / "r.yaml").write_text("filtered_at_hz: -5\n")
+    with pytest.raises(DataError, match="filtered_at_hz.*positive"):
+        read_sidecar(tmp_path / "r.csv")
+
+
 def test_chain_problem_below_its_cutoff_is_eq10_and_tempering_scales_it():
     # a record low-passed at 20 Hz, given as unfiltered: the chain's cut-off is then the DAQ's
     # anti-alias edge (0.8 x Nyquist) and its low-pass at 0.8 x that leaves eq. (10) alone

@@ -236,12 +236,13 @@ def test_the_frame_with_a_drifting_base_laser_is_a_warning(tmp_path, capsys) -> 
 
 @pytest.mark.skipif(not SILVERBOX.is_file(), reason="no data/public/silverbox")
 def test_the_silverbox_reads_in_volts() -> None:
-    """Read, and checked: its only warning is the displacement's speed read as m (it is in
-    volts; M, m not known, so not refused)."""
+    """Read, and checked: its sidecar says volts and no low-pass (its roll-off is the
+    excitation's band edge); its only warning is the displacement's speed read as m (it is
+    in volts; M, m not known, so not refused)."""
     from harvester.data.public import silverbox
     rec = silverbox(SILVERBOX, samples=4096)
     assert list(rec.data.columns) == ["time", "force", "rel_disp"] and len(rec.data) == 4096
-    assert rec.sidecar == {"units": {"force": "V", "displacement": "V"}}
+    assert rec.sidecar == {"units": {"force": "V", "displacement": "V"}, "filtered_at_hz": 0}
     assert "VOLTS" in rec.notes[0]
     assert 1.0 / np.mean(np.diff(rec.data.time)) == pytest.approx(610.35, abs=0.01)
     found = checks.check_recording(rec.data, RecordingKinds("force", "rel_disp"),

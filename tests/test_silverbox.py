@@ -111,3 +111,40 @@ def test_the_silverbox_cut_and_its_integration() -> None:
         err = np.sqrt(np.mean((auto.rel_disp - fine.rel_disp) ** 2))
         assert err < tol * np.std(fine.rel_disp), (k_cubic, err)
     assert REFERENCE_DEVICE.k / REFERENCE_DEVICE.z**2 / sd > 1e4
+
+
+BENCHMARK = SILVERBOX.with_name("SNLS80mV.mat")
+
+
+@pytest.mark.skipif(not BENCHMARK.is_file(), reason="no data/public/silverbox/SNLS80mV.mat")
+def test_the_benchmark_cut_as_the_benchmark_makes_it(tmp_path) -> None:
+    """The fit is the training multisine's start; each test holds the raw channels over the
+    loader's samples less the training samples' means (so nothing of a test enters the
+    offsets); the arrow without extrapolation is the full arrow's first 32000 samples; a
+    record of another length, or more fit samples than the training multisine holds, is
+    refused naming the file."""
+    from scipy.io import loadmat
+
+    from harvester.data.errors import DataError
+    from harvester.data.public import SILVERBOX_TESTS, SILVERBOX_TRAIN, silverbox_benchmark
+    raw = loadmat(str(BENCHMARK))
+    u, y = raw["V1"].ravel(), raw["V2"].ravel()
+    split = silverbox_benchmark(BENCHMARK, 1000)
+    a, b = SILVERBOX_TRAIN
+    assert split.offsets == pytest.approx((u[a:b].mean(), y[a:b].mean()))
+    assert np.allclose(split.fit.data["force"], u[a:a + 1000] - u[a:b].mean())
+    assert np.allclose(split.fit.data["rel_disp"], y[a:a + 1000] - y[a:b].mean())
+    for name, (i, j) in SILVERBOX_TESTS.items():
+        tu, ty = split.tests[name]
+        assert np.allclose(tu, u[i:j] - split.offsets[0])
+        assert np.allclose(ty, y[i:j] - split.offsets[1])
+    full, short = split.tests["arrow_full"][1], split.tests["arrow_no_extrapolation"][1]
+    assert np.array_equal(short, full[:32000])
+    assert np.abs(full).max() > 1.3 * np.abs(y[a:b] - split.offsets[1]).max()
+    with pytest.raises(DataError, match="fit samples"):
+        silverbox_benchmark(BENCHMARK, b - a + 1)
+    from scipy.io import savemat
+    short_file = tmp_path / "short.mat"
+    savemat(str(short_file), {"V1": u[:100000], "V2": y[:100000]})
+    with pytest.raises(DataError, match="short.mat.*100000 samples"):
+        silverbox_benchmark(short_file, 1000)

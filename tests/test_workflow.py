@@ -222,3 +222,34 @@ def test_a_new_sheet_runs_with_no_edit_of_the_workflow(tmp_path):
     assert row["recording"] == "run_2" and 0 < row["nrmse"] < 1
     assert (group / "validation/linear/run_2/predictive.png").stat().st_size > 10_000
     assert not (group / "diagnosis").exists()
+
+
+@pytest.mark.skipif(not (ROOT / "data/public/silverbox/SNLS80mV.mat").is_file(),
+                    reason="no data/public/silverbox/SNLS80mV.mat")
+def test_a_group_on_the_silverbox_benchmark_is_scored_on_its_tests(tmp_path):
+    """A sheet of one group trained on SNLS80mV.mat (kind public): rule silverbox_benchmark
+    simulates its models (a few TMCMC particles) on the benchmark's three tests. The cubic
+    model's errors lie below the linear one's on every test (the circuit's cubic spring),
+    each in mV against an output of about 50 mV RMS, and the published rows follow with
+    their sources."""
+    from harvester.data.public import SILVERBOX_PUBLISHED, SILVERBOX_TESTS
+    write_sheet(tmp_path / "sb.tsv", [["sb", str(ROOT / "data/public/silverbox/SNLS80mV.mat"),
+                                       "public", "", "training", "sb"]])
+    (tmp_path / "config").mkdir()
+    (tmp_path / "config/config.yaml").write_text(yaml.safe_dump({
+        "recordings": "sb.tsv", "models": ["linear", "linear+cubic_stiffness"],
+        "tmcmc": {"particles": 60, "chains": 1, "seed": 1, "mcmc_steps": 1,
+                  "max_mcmc_steps": 2, "start": "map"},
+        "predictive": {"samples": 10, "seed": 1},
+        "groups": {"sb": {"diagnose": False, "fit_seconds": 3.0}}}))
+    proc = snakemake(tmp_path, "--cores", "2", "results/groups/sb/benchmark.csv")
+    assert proc.returncode == 0, (proc.stdout + proc.stderr)[-6000:]
+    table = pd.read_csv(tmp_path / "results/groups/sb/benchmark.csv")
+    assert list(table["model"][:2]) == ["linear", "linear+cubic_stiffness"]
+    ours = table.set_index("model").loc[["linear", "linear+cubic_stiffness"],
+                                        list(SILVERBOX_TESTS)]
+    assert (ours.loc["linear+cubic_stiffness"] < ours.loc["linear"]).all()
+    assert ((ours > 0.1) & (ours < 30)).all().all()
+    assert list(table["model"][2:]) == [m for m, _, _ in SILVERBOX_PUBLISHED]
+    html = (tmp_path / "results/groups/sb/benchmark.html").read_text()
+    assert "Beintema" in html and "arrow full (mV)" in html

@@ -39,6 +39,10 @@ SHEET = load_sheets(
 GROUPS = {name: group_settings(config, name) for name in SHEET.groups}
 GENERIC_GROUPS = [g for g, grp in SHEET.groups.items() if grp.chain != EMPS]
 EMPS_GROUP = next((g for g, grp in SHEET.groups.items() if grp.chain == EMPS), None)
+#: Groups trained on the Silverbox benchmark's own record: its tests beside the published
+#: errors (rule silverbox_benchmark).
+BENCHMARK_GROUPS = [g for g in GENERIC_GROUPS
+                    if Path(SHEET.file(SHEET.groups[g].training)).name == "SNLS80mV.mat"]
 STUDY_GROUPS = [g for g, s in GROUPS.items() if s["study"] == "paper"]
 STUDY_GROUP = STUDY_GROUPS[0] if STUDY_GROUPS else None
 #: Where each group's files go.
@@ -256,6 +260,8 @@ def group_outputs(group):
         out += [f"{validation_dir(group, m, r)}/predictive.png" for r in grp.validation]
         if DIAGNOSED[group] and diagnosed_model(group, m):
             out.append(diagnosis_file(group, m, "summary.html"))
+    if group in BENCHMARK_GROUPS:
+        out.append(f"results/groups/{group}/benchmark.csv")
     return out
 
 

@@ -302,12 +302,17 @@ def _read(path: Path, paper_device: bool, accept=None, known=None, known_from=No
 
 def _lowpass(args: argparse.Namespace, checked) -> tuple[float | None, str]:
     """The zero-phase low-pass the recording went through (Hz or None) and where it is from."""
-    from harvester.diagnosis.spectral import filter_cutoff
+    from harvester.diagnosis.spectral import filter_cutoff, shared_roll_off
     if args.filtered_at is not None:
         return (args.filtered_at or None), "--filtered-at"
     if checked.sidecar.filtered_at_hz is not None:
-        return checked.sidecar.filtered_at_hz, f"filtered_at_hz in {checked.sidecar.path}"
-    found = filter_cutoff(checked.data[checked.kinds.output_kind].to_numpy(), 1.0 / checked.dt)
+        return (checked.sidecar.filtered_at_hz or None), \
+            f"filtered_at_hz in {checked.sidecar.path}"
+    df, fs = checked.data, 1.0 / checked.dt
+    found = filter_cutoff(df[checked.kinds.output_kind].to_numpy(), fs)
+    shared = shared_roll_off(df[checked.kinds.input_kind].to_numpy(), found, fs)
+    if shared:
+        log.warning("%s: %s", checked.sidecar.path, shared)
     return found, ("found from the output's spectrum (give --filtered-at to override)"
                    if found else "none found in the output's spectrum")
 
@@ -513,7 +518,9 @@ def _diagnosis_inputs(args: argparse.Namespace):
     if not input_kind(checked.kinds.input_kind).force_input and \
             not {"M", "m", "k"} & set(kp.values):  # eq. (1) cannot fix the scale
         kp.require(("M", "m", "k"), DIAGNOSE_NEEDS, checked.sidecar)
-    df, lowpass = checked.data, args.filtered_at or checked.sidecar.filtered_at_hz
+    # 0 (--filtered-at 0, a sidecar's filtered_at_hz: 0): none, and the diagnosis looks for none
+    df, lowpass = checked.data, (args.filtered_at if args.filtered_at is not None
+                                 else checked.sidecar.filtered_at_hz)
     notes = [str(w) for w in checked.warnings] + kp.notes(checked.sidecar)
     validation = None
     if args.validation is not None:
@@ -551,8 +558,8 @@ def _friction_form(args: argparse.Namespace, df, validation, known, sidecar, set
         return df, validation, known, []
 
     def priors_of(d, k):
-        return diagnosis_priors(d, args.baseline, k, sidecar.priors, settings.lowpass_hz,
-                                source)[0]
+        return diagnosis_priors(d, args.baseline, k, sidecar.priors,
+                                settings.lowpass_hz or None, source)[0]
     choice = choose_topology(df, known, args.baseline, priors_of, settings, source)
     notes = [choice.sentence(source)]
     if choice.chosen == "ground":
@@ -578,7 +585,7 @@ def diagnose_command(args: argparse.Namespace) -> int:
     notes += form_notes
     try:
         priors, prior_notes = diagnosis_priors(df, args.baseline, known, sidecar.priors,
-                                               settings.lowpass_hz, str(args.recording))
+                                               settings.lowpass_hz or None, str(args.recording))
     except KeyError as err:  # a prior in the sidecar for a parameter the library lacks
         raise DataError(sidecar.path, str(err.args[0])) from None
     except ValueError as err:  # the FRF fit of unknown M, m, k failed

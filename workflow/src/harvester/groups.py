@@ -113,16 +113,21 @@ def _sidecar_text(known: Mapping[str, float], priors: Mapping, filtered_at: floa
 def _cutoff(first, given, sidecar, lowpass_hz: float | None) -> tuple[float | None, str]:
     """(low-pass the recording went through, Hz or None; where that is from): the workflow's,
     unless the sidecar's is lower; else the sidecar's; else found in the output's spectrum."""
-    from harvester.diagnosis.spectral import filter_cutoff
+    from harvester.diagnosis.spectral import filter_cutoff, shared_roll_off
     if lowpass_hz:
-        if given.filtered_at_hz is not None and given.filtered_at_hz < float(lowpass_hz):
+        if given.filtered_at_hz and given.filtered_at_hz < float(lowpass_hz):
             return given.filtered_at_hz, "the sidecar (below the workflow's low-pass)"
         return float(lowpass_hz), "the workflow's zero-phase low-pass (config)"
-    if given.filtered_at_hz is not None:
-        return given.filtered_at_hz, f"the sidecar {sidecar}"
-    found = filter_cutoff(first.data[first.kinds.output_kind].to_numpy(float), 1.0 / first.dt)
-    return found, ("found from the output's spectrum" if found else
-                   "none given, none found in the output's spectrum")
+    if given.filtered_at_hz is not None:  # 0: none, kept so that no later step looks for one
+        return given.filtered_at_hz, f"the sidecar {sidecar}" + (
+            "" if given.filtered_at_hz else ": no low-pass")
+    fs, data = 1.0 / first.dt, first.data
+    found = filter_cutoff(data[first.kinds.output_kind].to_numpy(float), fs)
+    shared = shared_roll_off(data[first.kinds.input_kind].to_numpy(float), found, fs)
+    if shared:
+        log.warning("%s: %s", sidecar or "<no sidecar>", shared)
+    return found, ("found from the output's spectrum" + (f" ({shared})" if shared else "")
+                   if found else "none given, none found in the output's spectrum")
 
 
 def prepare_recording(source: str | Path, sidecar: str | Path | None, out_csv: str | Path,
@@ -189,7 +194,7 @@ def prepare_recording(source: str | Path, sidecar: str | Path | None, out_csv: s
 
 def _window(settings: Mapping[str, Any], lowpass: float | None):
     from harvester.inference.recording_fit import FitWindow
-    return FitWindow(float(settings["lead_in_s"]), lowpass, int(settings["filter_order"]),
+    return FitWindow(float(settings["lead_in_s"]), lowpass or None, int(settings["filter_order"]),
                      settings["fit_seconds"])
 
 

@@ -9,7 +9,8 @@ M              kg     effective mass m + J (2 pi / l)^2 (eq. 2)
 m              kg     oscillating mass (M >= m)
 k              N/m    spring stiffness
 priors                ``{parameter: {mean, sd}}``, e.g. a static test's ``F_c``
-filtered_at_hz Hz     cut-off of a zero-phase low-pass the recording already went through
+filtered_at_hz Hz     cut-off of a zero-phase low-pass the recording already went through (0:
+                      none, and none is looked for in its spectrum)
 friction_on           ``base`` or ``ground``: what the device's friction acts on, the
                       velocity relative to the base, or the mass's own (a contact fixed
                       to the ground, as on the frame of Marino and Cicirello);
@@ -44,7 +45,7 @@ log = logging.getLogger("harvester.data.sidecar")
 #: Keys of a sidecar and what each holds.
 SIDECAR_KEYS: dict[str, str] = {
     "M": "effective mass (kg)", "m": "oscillating mass (kg)", "k": "stiffness (N/m)",
-    "priors": "{parameter: {mean, sd}}", "filtered_at_hz": "low-pass already applied (Hz)",
+    "priors": "{parameter: {mean, sd}}", "filtered_at_hz": "low-pass already applied (Hz; 0: none)",
     "friction_on": "base or ground (what the friction acts on)",
     "units": "{force: UNIT, displacement: UNIT} where not N and m",
 }
@@ -154,8 +155,9 @@ def read_sidecar(recording: str | Path) -> Sidecar:
         raise DataError(path, f"'friction_on' must be base or ground (what the device's "
                         f"friction acts on), got {friction_on!r}", line=lines.get("friction_on"))
     return Sidecar(path, True, known, _priors(path, meta.get("priors", {}), lines.get("priors")),
-                   None if cutoff is None else _positive(path, "filtered_at_hz", cutoff,
-                                                         lines.get("filtered_at_hz")),
+                   None if cutoff is None else 0.0 if cutoff == 0 and not isinstance(
+                       cutoff, bool) else _positive(path, "filtered_at_hz", cutoff,
+                                                    lines.get("filtered_at_hz")),
                    friction_on, read_units(path, meta.get("units"), lines.get("units")))
 
 

@@ -27,7 +27,7 @@ from harvester.diagnosis.confirm import fit_structure, map_reference
 from harvester.diagnosis.fits import ModelFit
 from harvester.diagnosis.detect import band_top, estimate_temper
 from harvester.diagnosis.settings import DiagnosisSettings
-from harvester.diagnosis.spectral import filter_cutoff
+from harvester.diagnosis.spectral import recording_lowpass, shared_roll_off
 from harvester.inference.problems import make_problem
 from harvester.inference.posterior import (log_evidence as idata_log_evidence,
                                           parameter_names as idata_parameter_names,
@@ -168,8 +168,11 @@ def prepare(recording: pd.DataFrame, validation: pd.DataFrame | None,
         validation, _ = check_recording(validation, "<validation>", settings.lead_in_s, 0.0)
     base = named_structure(baseline) if isinstance(baseline, str) else baseline
     output = rec.columns[2]  # check_recording: time, input, output
-    lowpass = settings.lowpass_hz or filter_cutoff(rec[output].to_numpy(), 1.0 / dt)
+    lowpass = recording_lowpass(settings.lowpass_hz, rec[output].to_numpy(), 1.0 / dt)
     kind_notes: list[str] = []
+    if settings.lowpass_hz is None:
+        shared = shared_roll_off(rec[rec.columns[1]].to_numpy(), lowpass, 1.0 / dt)
+        kind_notes += [shared] if shared else []
     rec, validation = model_kinds(rec, validation, lowpass, source, kind_notes)
     rec, validation, dt, notes = resample_for_model(rec, validation, dt, lowpass)
     notes[:0] = kind_notes
@@ -189,9 +192,10 @@ def prepare(recording: pd.DataFrame, validation: pd.DataFrame | None,
                    lead, hold, fit_stop, end, detection_raw,
                    make_problem(rec, base, known, window=(lead, fit_stop)), notes, floor)
     t = out.time
+    said = f"{lowpass:.1f} Hz" if lowpass else \
+        "none found" if settings.lowpass_hz is None else "none (given)"
     log.info("recording %s: %.1f s at %.0f Hz; low-pass %s; analysed %.1f-%.1f s, TMCMC on "
-             "%.1f-%.1f s", source, n * dt, fs,
-             f"{lowpass:.1f} Hz" if lowpass else "none found", t[lead], t[hold - 1], t[lead],
+             "%.1f-%.1f s", source, n * dt, fs, said, t[lead], t[hold - 1], t[lead],
              t[fit_stop - 1])
     for line in settings.trades():
         log.warning("these settings trade away: %s", line)

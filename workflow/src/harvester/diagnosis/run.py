@@ -32,7 +32,7 @@ from harvester.diagnosis.report import UnseenFit, unseen_fit
 from harvester.diagnosis.rounds import Round, run_rounds
 from harvester.diagnosis.settings import DiagnosisSettings
 from harvester.diagnosis.signatures import candidate_terms
-from harvester.diagnosis.spectral import filter_cutoff
+from harvester.diagnosis.spectral import recording_lowpass
 from harvester.diagnosis.floor import Floor, output_floor
 from harvester.diagnosis.missing_force import MissingForce, NamedEffect, missing_force
 from harvester.diagnosis.relevance import RelevanceFloor
@@ -259,7 +259,7 @@ def quick_detect(recording: pd.DataFrame, baseline: str | ModelStructure,
     recordings. The whole recording after the lead-in is analysed (nothing held out)."""
     rec, dt = check_recording(recording, "<recording>", settings.lead_in_s, 0.0)
     base = named_structure(baseline) if isinstance(baseline, str) else baseline
-    lowpass = settings.lowpass_hz or filter_cutoff(rec.iloc[:, 2].to_numpy(), 1.0 / dt)
+    lowpass = recording_lowpass(settings.lowpass_hz, rec.iloc[:, 2].to_numpy(), 1.0 / dt)
     rec, _ = model_kinds(rec, None, lowpass, "<recording>", [])
     rec, _, dt, _ = resample_for_model(rec, None, dt, lowpass)
     fs = 1.0 / dt

@@ -37,7 +37,7 @@ class DiagnosisSettings:
     the whole window the detection analyses, all but the holdout); holdout_fraction: share of
     the recording's end kept unseen when no validation record is given; lowpass_hz: cut-off
     of the zero-phase low-pass the recording went through (None: found from its spectrum,
-    ``spectral.filter_cutoff``); filter_order: its order; candidates: library terms
+    ``spectral.recording_lowpass``; 0: none, and none looked for); filter_order: its order; candidates: library terms
     considered (None: all); predictive_samples: posterior samples simulated for the
     unseen-data comparison; figures: write figures;
     reference_start: half of each model's initial particles start where other evidence puts

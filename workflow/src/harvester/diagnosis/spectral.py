@@ -76,6 +76,35 @@ def filter_cutoff(x: np.ndarray, fs: float) -> float | None:
     return None
 
 
+def recording_lowpass(given: float | None, output: np.ndarray, fs: float) -> float | None:
+    """The low-pass (Hz) a recording's output went through: ``given`` (a sidecar's
+    ``filtered_at_hz``, ``--filtered-at``; 0: none, and none is looked for), else the one
+    its spectrum shows (:func:`filter_cutoff`), else None."""
+    if given is not None:
+        return float(given) or None
+    return filter_cutoff(output, fs)
+
+
+#: A found roll-off the input shows within this factor of the output's is noted as shared.
+SHARED_ROLL_OFF = 1.1
+
+
+def shared_roll_off(input: np.ndarray, cutoff: float | None, fs: float) -> str | None:
+    """A note when the input rolls off where the output's low-pass was found: an excitation's
+    band edge (a multisine's, the Silverbox's at 190 Hz) looks like a filter in both channels
+    but is none, and filtering the model's output there as well removes response the
+    recording holds (on the Silverbox: its cubic fit's noise sd 0.76 mV against 0.33 mV with
+    ``filtered_at_hz: 0``). Either may be right; the note gives the evidence and the remedy."""
+    if cutoff is None:
+        return None
+    own = filter_cutoff(input, fs)
+    if own is None or not own <= SHARED_ROLL_OFF * cutoff:
+        return None
+    return (f"the input rolls off at {own:.4g} Hz too, where the output's low-pass was found "
+            f"({cutoff:.4g} Hz): if that is the excitation's band edge and the recording went "
+            "through no low-pass, say filtered_at_hz: 0 in its sidecar (--filtered-at 0)")
+
+
 @dataclass
 class Frame:
     """Analysis window, taper, frequency grid and passband mask."""
