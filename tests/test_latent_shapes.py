@@ -462,3 +462,29 @@ def test_an_unread_force_says_when_z_itself_is_unknown():
     vague = describe(dataclasses.replace(lf, disp_sd=np.full(lf.time.size, 1e-3)))
     assert not vague.readable
     assert "z itself is known to +-1 mm only (RMS 0.71 mm)" in vague.sentence
+
+
+def test_the_missing_forces_shape_nominates_the_terms_never_tried():
+    """A cubic spring (2e6 N/m^3) missing from a displacement record, nothing named: the
+    missing force is odd in z and nominates the library's cubic spring and end stop
+    (``verdict.nominated_terms``), but not a term the rounds tried, nor one the structure
+    cannot take, nor any where a name with the force's shape stands; a force that cannot
+    be read (none missing) nominates nothing."""
+    from dataclasses import replace
+
+    from harvester.diagnosis.missing_force import missing_force
+    from harvester.diagnosis.verdict import Conclusion, nominated_terms
+    everything = tuple(TERMS)
+    out = missing_force(linear_state(recording(rk4_record(lambda z, v, t: 2e6 * z**3, 12.0),
+                                               "rel_disp")), draws=20)
+    assert out.description.readable and out.description.determined[0].name == "odd in z"
+    found = Conclusion("missing_physics", [], [], True, [], None, False)
+    assert nominated_terms(found, out, everything) == list(library_terms("odd in z"))
+    assert nominated_terms(replace(found, tried={"end_stop"}), out, everything) == \
+        ["cubic_stiffness"]
+    assert nominated_terms(found, out, ("coulomb_friction", "end_stop")) == ["end_stop"]
+    assert nominated_terms(replace(found, missing=["end_stop"]), out, everything) == []
+    none = missing_force(linear_state(recording(rk4_record(lambda z, v, t: 0.0 * z, 12.0),
+                                                "rel_disp")), draws=20)
+    assert not none.description.readable and nominated_terms(found, none, everything) == []
+    assert nominated_terms(found, None, everything) == []

@@ -60,10 +60,12 @@ class Current:
     priors: dict
 
 
-def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSettings
+def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSettings,
+               nominated: tuple[str, ...] = ()
                ) -> tuple[list[Round], ModelFit | None, bool, list[str]]:
     """(rounds, the baseline's fit (sampled here if the start had none and a round needed it),
-    whether a detected mismatch is left unexplained, notes)."""
+    whether a detected mismatch is left unexplained, notes). ``nominated``: effects the first
+    round screens beside its ranking's (the missing force's, ``verdict.nominated_terms``)."""
     now = Current(analysis.structure, start.fit, start.samples, dict(start.priors))
     rounds, notes, unexplained = [], [], False
     baseline_fit = start.fit
@@ -74,9 +76,10 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
         # a candidate whose own score is significant is screened even where the family's
         # maximum is not: the evidence, not the detection, decides what is named
         chosen = to_confirm(rnd.ranked, det, settings.screen)
-        if r == settings.rounds or not (det.significant or det.conflict or chosen):
+        extra = [e for e in nominated if r == 0 and e not in {c.effect for c in chosen}]
+        if r == settings.rounds or not (det.significant or det.conflict or chosen or extra):
             break
-        if not chosen:
+        if not chosen and not extra:
             unexplained = unexplained or det.significant
             if det.significant:
                 notes.append(f"round {r + 1}: mismatch detected (p = {det.p_value:.3g}) but no "
@@ -88,6 +91,7 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
             baseline_fit = baseline_fit or now.fit
         scale = rnd.scale = motion_scale(rnd.state, analysis.window, det.frame.f_high)
         effects = [c.effect for c in chosen + rivals(rnd.ranked, chosen)]
+        effects += [e for e in extra if e not in effects]
         rnd.screen = screen(now.fit, effects, now.priors, scale, det, settings.seed + r)
         # the acceptance shares alpha among every candidate the round could name
         confirmation = replace(settings.confirmation(), family=len(det.candidates))

@@ -37,7 +37,7 @@ from harvester.diagnosis.floor import Floor, output_floor
 from harvester.diagnosis.missing_force import MissingForce, NamedEffect, missing_force
 from harvester.diagnosis.relevance import RelevanceFloor
 from harvester.diagnosis.verdict import (Conclusion, FitJudgement, Tie, conclude,
-                                          decide_verdict, judge)
+                                          decide_verdict, judge, nominated_terms)
 from harvester.inference.problems import make_problem
 from harvester.inference.priors import PriorSpec
 from harvester.model.structures import ModelStructure
@@ -112,17 +112,25 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
     clock = time.perf_counter()
     analysis = prepare(recording, validation, baseline, known, settings, source)
     start = start_baseline(analysis, priors, posterior, settings)
-    rounds, baseline_fit, unexplained, notes = run_rounds(analysis, start, settings)
-    found = conclude(rounds, unexplained, settings, analysis.f_high)
-    before, after, unseen_notes = unseen_comparison(analysis, start, found.improved_fit,
-                                                    settings)
-    fit = fit_judgement(start, rounds[0], before, after)
-    missing, missing_notes = estimate_missing_force(analysis, rounds[0].state, found, settings,
-                                                    fit.floor)
-    found = judge(found, rounds[0].detection, fit, analysis.structure.name, settings, missing)
-    unseen_notes += missing_notes
-    diag = _diagnosis(analysis, start, rounds, baseline_fit, found, (before, after), settings,
-                      analysis.notes + notes + found.notes + unseen_notes,
+    passes = _pass(analysis, start, settings)
+    nominated = nominated_terms(passes.found, passes.missing, candidate_terms(
+        analysis.structure.terms, settings.candidates))
+    if nominated:
+        best = passes.missing.description.determined[0]
+        log.info("the missing force is %s (%.0f sd out): the library's %s, of that shape, "
+                 "not tried; the rounds again with %s screened", best.name, best.standing_sd,
+                 ", ".join(nominated), "it" if len(nominated) == 1 else "them")
+        passes = _pass(analysis, start, settings, tuple(nominated))
+        passes.notes.append(f"{', '.join(nominated)} screened because the missing force is "
+                            f"{best.name} ({best.standing_sd:.0f} sd out), though the "
+                            "detection's scores did not point to "
+                            f"{'it' if len(nominated) == 1 else 'them'}")
+    rounds, found = passes.rounds, passes.found
+    found = judge(found, rounds[0].detection, passes.fit, analysis.structure.name, settings,
+                  passes.missing)
+    missing = passes.missing
+    diag = _diagnosis(analysis, start, rounds, passes.baseline_fit, found, passes.unseen,
+                      settings, analysis.notes + passes.notes + found.notes + passes.more,
                       time.perf_counter() - clock)
     diag.missing_force = missing
     log.info("verdict: %s%s (%.0f s)", diag.headline,
@@ -131,6 +139,35 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
     if out_dir is not None:
         write(diag, out_dir)
     return diag
+
+
+@dataclass
+class _Pass:
+    """The rounds and what is read from them before the verdict: their conclusion, the fit
+    on unseen data, its judgement, the missing force; notes of the rounds and of the rest."""
+
+    rounds: list
+    baseline_fit: ModelFit | None
+    found: Conclusion
+    unseen: tuple
+    fit: FitJudgement
+    missing: MissingForce | None
+    notes: list[str]
+    more: list[str]
+
+
+def _pass(analysis: Analysis, start: BaselineStart, settings: DiagnosisSettings,
+          nominated: tuple[str, ...] = ()) -> _Pass:
+    """The rounds (``nominated`` effects screened in the first), their conclusion, the fit on
+    unseen data and the missing force."""
+    rounds, baseline_fit, unexplained, notes = run_rounds(analysis, start, settings, nominated)
+    found = conclude(rounds, unexplained, settings, analysis.f_high)
+    before, after, more = unseen_comparison(analysis, start, found.improved_fit, settings)
+    fit = fit_judgement(start, rounds[0], before, after)
+    missing, missing_notes = estimate_missing_force(analysis, rounds[0].state, found, settings,
+                                                    fit.floor)
+    return _Pass(rounds, baseline_fit, found, (before, after), fit, missing, notes,
+                 more + missing_notes)
 
 
 def _diagnosis(a: Analysis, start: BaselineStart, rounds: list[Round],

@@ -109,6 +109,11 @@ class ShapeDescription:
     def best(self) -> Shape:
         return self.shapes[0]
 
+    @property
+    def determined(self) -> list[Shape]:
+        """The shapes, best first, whose fit the record determines (not ``slow``)."""
+        return [s for s in self.shapes if s.name not in self.slow]
+
     def share_of(self, banded: np.ndarray) -> float:
         """The share of the missing force a force explains, as each shape's is read: less
         its mean, within the determined band (``banded``: already through the latent
@@ -726,7 +731,7 @@ def has_its_shape(description: ShapeDescription, terms: Sequence[str], share: fl
     record determines (not one of ``description.slow``) is one of theirs (``library_terms``),
     or their force explains within NAME_MARGIN of what it does. True where the force cannot
     be read or no shape is determined (nothing to check against)."""
-    determined = [s for s in description.shapes if s.name not in description.slow]
+    determined = description.determined
     if not description.readable or not determined:
         return True
     best = determined[0]
