@@ -148,3 +148,27 @@ def test_the_benchmark_cut_as_the_benchmark_makes_it(tmp_path) -> None:
     savemat(str(short_file), {"V1": u[:100000], "V2": y[:100000]})
     with pytest.raises(DataError, match="short.mat.*100000 samples"):
         silverbox_benchmark(short_file, 1000)
+
+
+@pytest.mark.skipif(not BENCHMARK.is_file(), reason="no data/public/silverbox/SNLS80mV.mat")
+def test_a_term_the_ranking_left_out_is_nominated_by_the_missing_force(monkeypatch) -> None:
+    """The benchmark's training multisine, linear baseline, with a ranking that puts no
+    candidate forward (``rounds.to_confirm`` and ``rounds.rivals`` patched to none, as the
+    study's Silverbox group's left the cubic spring out): the first pass names nothing, the
+    missing force reads odd in z, and the second pass screens the cubic spring and the end
+    stop it nominates and names the cubic spring, with a note saying why (``diagnosis.run``, ``verdict.nominated_terms``;
+    cheap settings)."""
+    from harvester.data.public import silverbox_benchmark
+    from harvester.diagnosis import DiagnosisSettings, diagnose, rounds
+    from harvester.initial.recording import diagnosis_priors
+    monkeypatch.setattr(rounds, "to_confirm", lambda *args, **kwargs: [])
+    monkeypatch.setattr(rounds, "rivals", lambda *args, **kwargs: [])
+    rec = silverbox_benchmark(BENCHMARK, 4400).fit.data
+    settings = DiagnosisSettings.fast(particles=100, figures=False, lowpass_hz=0.0,
+                                      bootstrap=100, artifact_components=10)
+    priors, _ = diagnosis_priors(rec, "linear", {}, {}, None, "SNLS80mV.mat")
+    d = diagnose(rec, "linear", {}, priors, settings=settings)
+    assert d.missing == ["cubic_stiffness"], d.headline
+    assert any("cubic_stiffness, end_stop screened because the missing force is odd in z" in n
+               for n in d.notes), d.notes
+    assert d.rounds[0].confirmed[0].effect == "cubic_stiffness"
