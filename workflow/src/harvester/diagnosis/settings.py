@@ -37,9 +37,9 @@ class DiagnosisSettings:
     the whole window the detection analyses, all but the holdout); holdout_fraction: share of
     the recording's end kept unseen when no validation record is given; lowpass_hz: cut-off
     of the zero-phase low-pass the recording went through (None: found from its spectrum,
-    ``spectral.recording_lowpass``; 0: none, and none looked for); filter_order: its order; candidates: library terms
-    considered (None: all); predictive_samples: posterior samples simulated for the
-    unseen-data comparison; figures: write figures;
+    ``spectral.recording_lowpass``; 0: none, and none looked for); filter_order: its order;
+    candidates: library terms considered (None: all); predictive_samples: posterior samples
+    simulated for the unseen-data comparison; figures: write figures;
     reference_start: half of each model's initial particles start where other evidence puts
     them, the baseline's at its MAP and Laplace covariance (``confirm.map_reference``), a
     candidate's at the nested model's posterior and, for a start shape (a mode's frequency),

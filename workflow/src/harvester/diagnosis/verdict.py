@@ -250,10 +250,10 @@ def nominated_terms(found: Conclusion, missing: MissingForce | None,
     no name stands (none accepted, or withheld for lacking the force's shape), the force
     can be read and its best determined shape is one the library holds (``library_terms``),
     those of its terms among ``candidates`` (the terms the structure can take) that were
-    neither screened nor sampled (a tie stands as a name). A score test sees one probe shape and can miss the term
-    that has the force's own: on the Silverbox benchmark's training multisine a cubic spring
-    scored below its rivals' threshold while the missing force read odd in z, k_3 = 3.4
-    V/V^3 at 51 sd. The evidence then decides (``diagnosis.run``)."""
+    neither screened nor sampled (a tie stands as a name). A score test sees one probe
+    shape and can miss the term that has the force's own: in the study's Silverbox group
+    the cubic spring was not screened while the missing force read odd in z, k_3 = 3.76
+    V/V^3, standing 101 sd out. The evidence then decides (``diagnosis.run``)."""
     stands = (found.missing or found.ties) and withheld_names(found, missing) is None
     if missing is None or stands:
         return []
