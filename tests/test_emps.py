@@ -188,6 +188,40 @@ def test_parameter_and_evidence_tables() -> None:
     assert ev.loc[ev["model"] == "viscous", "log_evidence_gain"].item() == 0.0
 
 
+def test_the_diagnosis_summary_page_of_the_emps_study(tmp_path) -> None:
+    """``summary_doc``: the named term with its level beside the published one, every
+    candidate but the baseline (read back from CSV, its empty term as NaN), both models on
+    the unseen record; the page every diagnosis has renders it, figures with their lines."""
+    from harvester.diagnosis.summary_page import summary_page
+    evidence = pd.DataFrame({
+        "model": ["viscous+coulomb_friction", "viscous+tanh_friction", "viscous"],
+        "added_term": ["coulomb_friction", "tanh_friction", np.nan], "n_parameters": [4, 5, 3],
+        "log_evidence": [1840.0, 1839.5, 1630.0], "sd_over_chains": [0.1, 0.02, 0.02],
+        "log_evidence_gain": [210.0, 209.5, 0.0], "tied_with_best": [True, True, False]})
+    comparison = pd.DataFrame({"parameter": ["Fc"], "mean": [20.38], "q2.5": [19.48],
+                               "q97.5": [21.27], "published": [20.39]})
+    validation = pd.DataFrame({"model": ["viscous", "viscous+coulomb_friction"],
+                               "record": ["validation"] * 2, "rms_position_um": [6.9, 1.98],
+                               "nrmse_tracking": [0.0118, 0.0034]})
+    doc = emps.summary_doc(comparison, evidence, {"named_term": "coulomb_friction"},
+                           validation, "viscous", "viscous+coulomb_friction")
+    assert doc["missing"] == ["coulomb_friction"]
+    assert "F_c 20.38 N" in doc["headline"] and "published 20.39" in doc["headline"]
+    assert "from 6.9 to 1.98 um RMS" in doc["headline"]
+    assert [c["effect"] for c in doc["candidates"]] == ["coulomb_friction", "tanh_friction"]
+    assert [c["accepted"] for c in doc["candidates"]] == [True, False]
+    assert "tanh_friction" in doc["notes"][0]  # within a nat of the best
+    assert doc["fit"]["improved"]["nrmse"] == 0.0034
+    fig_dir = tmp_path / "figures"
+    fig_dir.mkdir()
+    import matplotlib.pyplot as plt
+    plt.figure(figsize=(1, 1)).savefig(fig_dir / "evidence.png")
+    plt.close("all")
+    page = summary_page(doc, fig_dir, "EMPS")
+    assert page.count("<figure>") == 1 and emps.results.SUMMARY_FIGURES["evidence.png"] in page
+    assert "<td>nan</td>" not in page
+
+
 @pytest.mark.slow
 def test_tmcmc_on_a_slice_is_within_5_percent(training) -> None:
     """TMCMC, Coulomb model, first 12 s, 200 particles: every parameter within 5 % (~1 min)."""

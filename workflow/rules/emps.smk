@@ -4,6 +4,8 @@
 # and baseline + each candidate term are identified by TMCMC, the evidence names the missing
 # physics, the extended model's parameters are compared with the published ones and both models
 # are validated on the unseen record (DATA_EMPS_PULSES). Settings: config emps.
+from harvester.emps.results import SUMMARY_FIGURES
+
 EMPS = config["emps"]
 EMPS_BASELINE = "viscous"
 EMPS_MODELS = [EMPS_BASELINE] + [f"viscous+{t}" for t in EMPS["candidates"]]
@@ -39,6 +41,10 @@ def emps_labels(result, model="-", role=None):
                       "recording": emps_name(role or w.get("record", "training"))}
 
 
+#: The figures the EMPS diagnosis's summary page embeds.
+EMPS_SUMMARY_FIGURES = list(SUMMARY_FIGURES)
+
+
 def emps_outputs():
     """Everything the EMPS group's page shows (target emps_all)."""
     return [
@@ -56,6 +62,7 @@ def emps_outputs():
                 part=["", "_zoom"]),
         "results/emps/headline.csv",
         "results/emps/headline.html",
+        "results/emps/summary.html",
     ]
 
 
@@ -249,11 +256,15 @@ rule emps_headline:
         named="results/emps/named_physics.json",
         validation="results/emps/validation.csv",
         posteriors=expand("results/emps/posterior/{model}.nc", model=EMPS_MODELS),
+        figures=expand("results/emps/figures/{name}", name=EMPS_SUMMARY_FIGURES),
     output:
         csv="results/emps/headline.csv",
         html=report("results/emps/headline.html", caption="../report/emps_headline.rst",
                     category=GROUP_PAGE, subcategory=EMPS_PAGE,
                     labels=emps_labels("0. headline", "all")),
+        summary=report("results/emps/summary.html", caption="../report/emps_summary.rst",
+                       category=GROUP_PAGE, subcategory=EMPS_PAGE,
+                       labels=emps_labels("0. diagnosis summary", "all")),
     params:
         models=EMPS_MODELS,
         baseline=EMPS_BASELINE,

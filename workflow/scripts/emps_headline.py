@@ -1,9 +1,13 @@
-"""Rule emps_headline: the EMPS study's numbers on one page (CSV and HTML)."""
+"""Rule emps_headline: the EMPS study's numbers on one page (CSV and HTML), and its diagnosis
+on the page every diagnosis has (summary.html)."""
+
+from pathlib import Path
 
 import pandas as pd
 
 from harvester import emps
 from harvester.data.fileio import atomic_path, read_json
+from harvester.diagnosis.summary_page import summary_page
 from harvester.runlog import rule_log
 from harvester.inference.posterior import read_posterior
 
@@ -18,4 +22,10 @@ with rule_log(snakemake) as log:  # noqa: F821
         table.to_csv(tmp, index=False, float_format="%.6g")
     with atomic_path(sm.output.html) as tmp:
         tmp.write_text(table.to_html(index=False, float_format=lambda x: f"{x:.5g}"))
+    doc = emps.summary_doc(pd.read_csv(sm.input.comparison), pd.read_csv(sm.input.evidence),
+                           read_json(sm.input.named), pd.read_csv(sm.input.validation),
+                           sm.params.baseline, sm.params.extended)
+    with atomic_path(sm.output.summary) as tmp:
+        tmp.write_text(summary_page(doc, Path(sm.input.figures[0]).parent,
+                                    "EMPS: the physics the viscous model misses"))
     log.info("\n%s", table.to_string(index=False))

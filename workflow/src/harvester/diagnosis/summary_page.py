@@ -120,7 +120,8 @@ STYLE = ("body{font-family:sans-serif;max-width:60em;margin:2em auto;color:#222}
 
 def summary_page(doc: Mapping[str, Any], figure_dir: str | Path, title: str) -> str:
     """The page (module docstring) of diagnosis.json ``doc`` with the figures in
-    ``figure_dir``."""
+    ``figure_dir``; figures of ``doc["figures"]`` outside :data:`SECTIONS` go last, with
+    their line from ``doc["figure_captions"]`` where it gives one."""
     figure_dir = Path(figure_dir)
     body = [f"<h1>{_esc(title)}</h1>",
             f'<p class="headline">{_esc(doc.get("headline") or doc.get("verdict"))}</p>',
@@ -140,7 +141,8 @@ def summary_page(doc: Mapping[str, Any], figure_dir: str | Path, title: str) -> 
             parts.insert(0, _fit_rows(doc))
         if parts:
             body.append(f"<h2>{_esc(section)}</h2>" + "".join(parts))
-    others = [_figure(figure_dir / Path(f).name, "")
+    captions = doc.get("figure_captions") or {}
+    others = [_figure(figure_dir / Path(f).name, captions.get(Path(f).name, ""))
               for f in doc.get("figures") or []
               if Path(f).name not in listed and (figure_dir / Path(f).name).is_file()]
     if others:

@@ -17,7 +17,7 @@ from harvester.emps.idim import IdimFit, idim_ls
 from harvester.emps.results import (CANDIDATES, TIE_NATS, VALIDATION_COLUMNS, TrackingBand,
                                     comparison_table, compare_terms, error_metrics,
                                     evidence_table, headline_table, parameters_table,
-                                    tracking_band)
+                                    summary_doc, tracking_band)
 
 __all__ = ["BASELINE_TERMS", "CANDIDATES", "FREE_BASE", "KNOWN", "PARAMETERS", "PUBLISHED",
            "TIE_NATS", "UNITS", "VALIDATION_COLUMNS", "ClosedLoopProblem",
@@ -25,5 +25,5 @@ __all__ = ["BASELINE_TERMS", "CANDIDATES", "FREE_BASE", "KNOWN", "PARAMETERS", "
            "TrackingBand", "check_controller", "closed_loop_fit", "closed_loop_problem",
            "comparison_table", "compare_terms", "correlation_time", "disturbance_voltage",
            "emps_model_name", "error_metrics", "evidence_table", "headline_table", "idim_ls",
-           "load_emps", "model_terms", "parameters_table", "simulate_closed_loop",
+           "load_emps", "model_terms", "parameters_table", "simulate_closed_loop", "summary_doc",
            "temper_from", "to_recording", "tracking_band"]
