@@ -92,10 +92,15 @@ def _fit_rows(doc: Mapping[str, Any]) -> str:
         nrmse = f.get("nrmse")
         rows.append(f"<tr><td>{which}</td><td>{_esc(f.get('structure'))}</td>"
                     f"<td>{'-' if nrmse is None else f'{nrmse:.3g}'}</td>"
-                    f"<td>{'-' if nrmse is None else f'{1 - nrmse ** 2:.1%}'}</td>"
+                    f"<td>{'-' if nrmse is None else _share(1 - nrmse ** 2)}</td>"
                     f"<td>{_esc(f.get('unseen_data') or '-')}</td></tr>")
     return ("<table><tr><th></th><th>model</th><th>NRMSE</th><th>share explained</th>"
             "<th>unseen data</th></tr>" + "".join(rows) + "</table>")
+
+
+def _share(x: float) -> str:
+    """A share in %, with the digits that tell 99.9 % from 99.99 %."""
+    return f"{x:.{1 if x < 0.999 else 3}%}"
 
 
 def _candidate_rows(doc: Mapping[str, Any]) -> str:
