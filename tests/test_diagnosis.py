@@ -70,11 +70,13 @@ def test_a_low_pass_given_as_none_is_not_looked_for_and_a_shared_roll_off_is_not
     rng = np.random.default_rng(1)
     u, y = rng.standard_normal((2, 20 * 256))
     y20 = lowpass(y, FS, 20.0, 8)
-    found = recording_lowpass(None, y20, FS)
-    assert found is not None and 17.0 < found <= 20.4
-    assert recording_lowpass(0.0, y20, FS) is None and recording_lowpass(25.0, y20, FS) == 25.0
+    found, none = recording_lowpass(None, u, y20, FS)
+    assert found is not None and 17.0 < found <= 20.4 and none is None
+    assert recording_lowpass(0.0, u, y20, FS) == (None, None)
+    assert recording_lowpass(25.0, u, y20, FS) == (25.0, None)
     note = shared_roll_off(lowpass(u, FS, 20.0, 8), found, FS)
     assert note is not None and "filtered_at_hz: 0" in note
+    assert recording_lowpass(None, lowpass(u, FS, 20.0, 8), y20, FS) == (found, note)
     assert shared_roll_off(lowpass(u, FS, 80.0, 8), found, FS) is None
     assert shared_roll_off(u, None, FS) is None
     (tmp_path / "r.yaml").write_text("filtered_at_hz: 0\n")

@@ -302,15 +302,15 @@ def _read(path: Path, paper_device: bool, accept=None, known=None, known_from=No
 
 def _lowpass(args: argparse.Namespace, checked) -> tuple[float | None, str]:
     """The zero-phase low-pass the recording went through (Hz or None) and where it is from."""
-    from harvester.diagnosis.spectral import filter_cutoff, shared_roll_off
+    from harvester.diagnosis.spectral import recording_lowpass
     if args.filtered_at is not None:
         return (args.filtered_at or None), "--filtered-at"
     if checked.sidecar.filtered_at_hz is not None:
         return (checked.sidecar.filtered_at_hz or None), \
             f"filtered_at_hz in {checked.sidecar.path}"
-    df, fs = checked.data, 1.0 / checked.dt
-    found = filter_cutoff(df[checked.kinds.output_kind].to_numpy(), fs)
-    shared = shared_roll_off(df[checked.kinds.input_kind].to_numpy(), found, fs)
+    df = checked.data
+    found, shared = recording_lowpass(None, df[checked.kinds.input_kind].to_numpy(),
+                                      df[checked.kinds.output_kind].to_numpy(), 1.0 / checked.dt)
     if shared:
         log.warning("%s: %s", checked.sidecar.path, shared)
     return found, ("found from the output's spectrum (give --filtered-at to override)"

@@ -113,7 +113,7 @@ def _sidecar_text(known: Mapping[str, float], priors: Mapping, filtered_at: floa
 def _cutoff(first, given, sidecar, lowpass_hz: float | None) -> tuple[float | None, str]:
     """(low-pass the recording went through, Hz or None; where that is from): the workflow's,
     unless the sidecar's is lower; else the sidecar's; else found in the output's spectrum."""
-    from harvester.diagnosis.spectral import filter_cutoff, shared_roll_off
+    from harvester.diagnosis.spectral import recording_lowpass
     if lowpass_hz:
         if given.filtered_at_hz and given.filtered_at_hz < float(lowpass_hz):
             return given.filtered_at_hz, "the sidecar (below the workflow's low-pass)"
@@ -121,9 +121,9 @@ def _cutoff(first, given, sidecar, lowpass_hz: float | None) -> tuple[float | No
     if given.filtered_at_hz is not None:  # 0: none, kept so that no later step looks for one
         return given.filtered_at_hz, f"the sidecar {sidecar}" + (
             "" if given.filtered_at_hz else ": no low-pass")
-    fs, data = 1.0 / first.dt, first.data
-    found = filter_cutoff(data[first.kinds.output_kind].to_numpy(float), fs)
-    shared = shared_roll_off(data[first.kinds.input_kind].to_numpy(float), found, fs)
+    data = first.data
+    found, shared = recording_lowpass(None, data[first.kinds.input_kind].to_numpy(float),
+                                      data[first.kinds.output_kind].to_numpy(float), 1.0 / first.dt)
     if shared:
         log.warning("%s: %s", sidecar or "<no sidecar>", shared)
     return found, ("found from the output's spectrum" + (f" ({shared})" if shared else "")
@@ -139,7 +139,7 @@ def prepare_recording(source: str | Path, sidecar: str | Path | None, out_csv: s
     The sidecar written is the sheet's (``sidecar``, or none) with ``filtered_at_hz``: the
     workflow's own low-pass (``lowpass_hz``, applied before: rule ``lowpass``), else the
     sheet sidecar's, else the cut-off found from the output's spectrum
-    (``diagnosis.spectral.filter_cutoff``), else none; every later step reads it from there,
+    (``diagnosis.spectral.recording_lowpass``), else none; every later step reads it from there,
     and the sheet sidecar's ``units`` where not N and m (the diagnosis's labels).
     Both files appear only when the checks pass (DataError naming the file otherwise). A
     sidecar's ``friction_on: ground`` rewrites the recording in absolute coordinates

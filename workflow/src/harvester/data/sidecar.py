@@ -99,6 +99,13 @@ def _positive(path: Path, key: str, value: Any, line: int | None) -> float:
     return float(value)
 
 
+def _cutoff_hz(path: Path, value: Any, line: int | None) -> float:
+    """``filtered_at_hz``: a positive cut-off (Hz), or 0 for no low-pass."""
+    if value == 0 and not isinstance(value, bool):
+        return 0.0
+    return _positive(path, "filtered_at_hz", value, line)
+
+
 def _priors(path: Path, priors: Any, line: int | None) -> dict[str, dict[str, float]]:
     if not isinstance(priors, dict):
         raise DataError(path, f"'priors' must map parameter names to {{mean, sd}}, got "
@@ -155,9 +162,8 @@ def read_sidecar(recording: str | Path) -> Sidecar:
         raise DataError(path, f"'friction_on' must be base or ground (what the device's "
                         f"friction acts on), got {friction_on!r}", line=lines.get("friction_on"))
     return Sidecar(path, True, known, _priors(path, meta.get("priors", {}), lines.get("priors")),
-                   None if cutoff is None else 0.0 if cutoff == 0 and not isinstance(
-                       cutoff, bool) else _positive(path, "filtered_at_hz", cutoff,
-                                                    lines.get("filtered_at_hz")),
+                   None if cutoff is None else _cutoff_hz(path, cutoff,
+                                                          lines.get("filtered_at_hz")),
                    friction_on, read_units(path, meta.get("units"), lines.get("units")))
 
 

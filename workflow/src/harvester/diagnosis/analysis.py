@@ -27,7 +27,7 @@ from harvester.diagnosis.confirm import fit_structure, map_reference
 from harvester.diagnosis.fits import ModelFit
 from harvester.diagnosis.detect import band_top, estimate_temper
 from harvester.diagnosis.settings import DiagnosisSettings
-from harvester.diagnosis.spectral import recording_lowpass, shared_roll_off
+from harvester.diagnosis.spectral import recording_lowpass
 from harvester.inference.problems import make_problem
 from harvester.inference.posterior import (log_evidence as idata_log_evidence,
                                           parameter_names as idata_parameter_names,
@@ -168,11 +168,9 @@ def prepare(recording: pd.DataFrame, validation: pd.DataFrame | None,
         validation, _ = check_recording(validation, "<validation>", settings.lead_in_s, 0.0)
     base = named_structure(baseline) if isinstance(baseline, str) else baseline
     output = rec.columns[2]  # check_recording: time, input, output
-    lowpass = recording_lowpass(settings.lowpass_hz, rec[output].to_numpy(), 1.0 / dt)
-    kind_notes: list[str] = []
-    if settings.lowpass_hz is None:
-        shared = shared_roll_off(rec[rec.columns[1]].to_numpy(), lowpass, 1.0 / dt)
-        kind_notes += [shared] if shared else []
+    lowpass, shared = recording_lowpass(settings.lowpass_hz, rec[rec.columns[1]].to_numpy(),
+                                        rec[output].to_numpy(), 1.0 / dt)
+    kind_notes: list[str] = [shared] if shared else []
     rec, validation = model_kinds(rec, validation, lowpass, source, kind_notes)
     rec, validation, dt, notes = resample_for_model(rec, validation, dt, lowpass)
     notes[:0] = kind_notes

@@ -296,7 +296,8 @@ def quick_detect(recording: pd.DataFrame, baseline: str | ModelStructure,
     recordings. The whole recording after the lead-in is analysed (nothing held out)."""
     rec, dt = check_recording(recording, "<recording>", settings.lead_in_s, 0.0)
     base = named_structure(baseline) if isinstance(baseline, str) else baseline
-    lowpass = recording_lowpass(settings.lowpass_hz, rec.iloc[:, 2].to_numpy(), 1.0 / dt)
+    lowpass, _ = recording_lowpass(settings.lowpass_hz, rec.iloc[:, 1].to_numpy(),
+                                   rec.iloc[:, 2].to_numpy(), 1.0 / dt)
     rec, _ = model_kinds(rec, None, lowpass, "<recording>", [])
     rec, _, dt, _ = resample_for_model(rec, None, dt, lowpass)
     fs = 1.0 / dt

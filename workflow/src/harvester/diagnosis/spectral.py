@@ -76,13 +76,16 @@ def filter_cutoff(x: np.ndarray, fs: float) -> float | None:
     return None
 
 
-def recording_lowpass(given: float | None, output: np.ndarray, fs: float) -> float | None:
-    """The low-pass (Hz) a recording's output went through: ``given`` (a sidecar's
-    ``filtered_at_hz``, ``--filtered-at``; 0: none, and none is looked for), else the one
-    its spectrum shows (:func:`filter_cutoff`), else None."""
+def recording_lowpass(given: float | None, input: np.ndarray, output: np.ndarray, fs: float
+                      ) -> tuple[float | None, str | None]:
+    """(the low-pass (Hz) a recording's output went through, a note or None): ``given`` (a
+    sidecar's ``filtered_at_hz``, ``--filtered-at``; 0: none, and none is looked for), else
+    the one the output's spectrum shows (:func:`filter_cutoff`) with :func:`shared_roll_off`'s
+    note on it, else None."""
     if given is not None:
-        return float(given) or None
-    return filter_cutoff(output, fs)
+        return float(given) or None, None
+    found = filter_cutoff(output, fs)
+    return found, shared_roll_off(input, found, fs)
 
 
 #: A found roll-off the input shows within this factor of the output's is noted as shared.

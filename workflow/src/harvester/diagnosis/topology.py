@@ -107,10 +107,11 @@ def choose_topology(df: pd.DataFrame, known: Mapping[str, float], baseline: str,
     forms = {f: _form(df, known, f, source) for f in FORMS}
     if settings.lowpass_hz is None:  # one low-pass for both: the recording's, as recorded
         from harvester.data.signals import uniform_step
-        from harvester.diagnosis.spectral import filter_cutoff
+        from harvester.diagnosis.spectral import recording_lowpass
         dt = uniform_step(df["time"].to_numpy(dtype=float), source)
-        settings = replace(settings, lowpass_hz=filter_cutoff(
-            df["rel_disp"].to_numpy(dtype=float), 1.0 / dt))
+        settings = replace(settings, lowpass_hz=recording_lowpass(
+            None, df["base_disp"].to_numpy(dtype=float), df["rel_disp"].to_numpy(dtype=float),
+            1.0 / dt)[0])
     # per form: its analysis and priors, once; the mode at lambda = 1 sets lambda and sigma
     prepared = {f: (prepare(forms[f][0], None, s, forms[f][1], settings, source),
                     priors_of(*forms[f])) for f in FORMS}

@@ -20,8 +20,8 @@ SAMPLES = 100
 COLUMNS = ["model", "source", *SILVERBOX_TESTS]
 
 
-def simulation_errors(idata: az.InferenceData, split: BenchmarkSplit, samples: int = SAMPLES,
-                seed: int = 0) -> dict[str, float]:
+def simulation_errors(idata: az.InferenceData, split: BenchmarkSplit,
+                      samples: int = SAMPLES, seed: int = 0) -> dict[str, float]:
     """Per test, the RMS error (mV) of the posterior's predictive mean (``samples`` thinned
     rows, simulated from rest for the test's input alone) after the first
     :data:`SILVERBOX_INIT` samples (``inference.unseen.heldout_error``)."""
