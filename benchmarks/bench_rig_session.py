@@ -15,8 +15,8 @@ line per setting:
 * ``sticks``, ``longest_stick_ms``, ``near_stick_pct`` (within 20 ms of a stick) and, per
   model, ``*_rms_near_over_elsewhere``: its RMS residual near the sticks over elsewhere, and
   ``*_nrmse_near_over_elsewhere`` the same of the residual relative to the measured output's
-  RMS there (``study.sticking``): Figure 7's claim that the linear model fails where the
-  device sticks reads > 1;
+  RMS there (``study.sticking``), and ``*_nrmse_stuck`` / ``*_nrmse_moving``: its RMS
+  residual over the record's RMS while the rig is stuck / moves;
 * ``tanh_sd``: their posterior sds by Laplace (Gauss-Newton Hessian), ``tanh_z``: (estimate -
   truth) / sd, the truth being the rig's Table 5 values; ``tanh_z_adj`` the same with the sds
   adjusted for correlated residuals (``inference.correlated_residuals``, flat priors);
@@ -142,13 +142,15 @@ def laplace_log_evidence(f: dict, priors: dict) -> float:
 def stick_statistics(stuck: np.ndarray, speed: np.ndarray, fits: dict,
                      fs: float = 256.0) -> dict:
     """Figure 7's question (``study.sticking``): the rig's sticks over the fitted samples and
-    each model's misfit near them over elsewhere, absolute and relative to the record."""
+    each model's misfit near them over elsewhere, absolute and relative to the record, and its
+    share of the record while the rig is stuck and while it moves."""
     y = next(iter(fits.values()))["problem"].observed
+    rig_keys = ("sticks", "longest_stick_ms", "stuck_pct", "near_stick_pct")
     out = {}
     for model, f in fits.items():
         m = stick_misfit(f["residual"], y, stuck, speed, fs).to_dict()
-        out.update({k: v for k, v in m.items() if "over" not in k})
-        out.update({f"{model}_{k}": v for k, v in m.items() if "over" in k})
+        out.update({k: v for k, v in m.items() if k in rig_keys})
+        out.update({f"{model}_{k}": v for k, v in m.items() if k not in rig_keys})
     return out
 
 

@@ -157,6 +157,12 @@ def test_validation_table_content(full_dir):
     head = pd.read_csv(full_dir / "results/tables/headline.csv")
     assert head.quantity.str.contains("Bayes factor").any()
     assert head.quantity.str.contains("adjusted for correlated residuals").sum() == 3
+    # Figure 7's misfit stuck / moving, for both models, as the figure's table gives it
+    stick = pd.read_csv(full_dir / "results/tables/figure7_sticking.csv").set_index("model")
+    assert set(stick.index) == {"linear", "tanh"}
+    rows = head[head.quantity.str.startswith("Figure 7")]
+    assert len(rows) == 2 and rows.ours.iloc[0] == (
+        f"{stick.loc['linear', 'nrmse_stuck']:.3g} / {stick.loc['linear', 'nrmse_moving']:.3g}")
 
 
 def test_the_report_has_the_paper_pages_and_a_page_per_group(full_dir):

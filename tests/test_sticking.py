@@ -30,10 +30,15 @@ def test_a_misfit_made_near_the_sticks_reads_above_one_and_by_speed():
     m = stick_misfit(residual, measured, stuck, speed, FS)
     assert m.sticks == 2 and m.longest_ms == pytest.approx(100.0)
     assert m.absolute_ratio == pytest.approx(3.0) and m.relative_ratio == pytest.approx(6.0)
-    shares = {(lo, hi): share for lo, hi, share, _ in m.by_speed}
-    assert shares[(0.0, 2.0)] == pytest.approx(0.015) and shares[(30.0, 60.0)] == pytest.approx(
-        0.985)
+    shares = {(lo, hi): share for lo, hi, share, _, _ in m.by_speed}
+    assert shares[(0.0, 2.0)] == 0.0 and shares[(30.0, 60.0)] == pytest.approx(0.985)
     assert m.to_dict()["nrmse_near_over_elsewhere"] == 6.0
+    # while stuck (all near): residual 3 on a record of 2; moving: near (3 on 2) and far (1 on
+    # 4) mixed by their counts
+    assert m.stuck == pytest.approx((3.0, 2.0)) and m.stuck_nrmse == pytest.approx(1.5)
+    moving = ~stuck
+    expected = np.sqrt(np.mean(residual[moving] ** 2) / np.mean(measured[moving] ** 2))
+    assert m.moving_nrmse == pytest.approx(expected)
 
 
 def test_the_zoom_is_centred_on_the_longest_stick_and_kept_inside():

@@ -7,6 +7,8 @@ rule headline:
         posteriors=[posterior_table(m) for m in MODELS],
         bayes="results/tables/bayes_factor.csv",
         validation="results/tables/validation.csv",
+        sticking="results/tables/figure7_sticking.csv",
+        unseen="results/predictive/tanh_validation.npz",
     output:
         csv="results/tables/headline.csv",
         html=report("results/tables/headline.html", caption="../report/headline.rst",

@@ -96,9 +96,11 @@ rule validation_table:
 rule fig07_linear_training:
     input:
         "results/predictive/linear_training.npz",
+        "results/predictive/tanh_training.npz",
     output:
         report("results/figures/fig07_linear_training.png", caption="../report/fig07.rst",
                category="Validation"),
+        "results/tables/figure7_sticking.csv",
     params:
         title="Linear model against the training data (Figure 7)",
         window=None,
@@ -106,6 +108,8 @@ rule fig07_linear_training:
         record="training",
         lead_in=config["preprocess"]["training_lead_in"],
         zoom_s=1.0,
+        model="linear",
+        compare="tanh",
     log:
         "logs/fig07.log",
     conda:

@@ -52,14 +52,16 @@ def response_figure(band: PredictiveBand, measured: np.ndarray, path: str | Path
                     measured_label: str = "measured (virtual rig)",
                     stuck: np.ndarray | None = None,
                     zoom: tuple[float, float] | None = None,
-                    misfit: StickMisfit | None = None) -> None:
+                    misfit: StickMisfit | None = None,
+                    compare: tuple[str, StickMisfit] | None = None) -> None:
     """Measured output in grey, model mean in black, +-k sd bounds shaded (two kinds: the
     paper's, the ensemble of parameter samples, and the full predictive with the likelihood's
     sigma), each labelled with the share of the shown measured samples outside it; ``note``
     is the subtitle, ``ylabel`` the output with its unit. ``stuck`` (bool per sample of the
     band): where the rig stuck, shaded. ``zoom`` (s): a second panel on that section.
-    ``misfit``: a last panel, the model's RMS misfit per band of screw speed and near the
-    sticks against elsewhere (``study.sticking``)."""
+    ``misfit``: a last panel, the model's RMS misfit while the rig is stuck, per band of screw
+    speed and near the sticks against elsewhere (``study.sticking``); ``compare``: another
+    model's (label, misfit) beside it."""
     t = band.time
     sel = slice(None) if window is None else (t >= window[0]) & (t <= window[1])
     width = 11 if window is None or (window[1] - window[0]) > 20 else 9
@@ -79,25 +81,52 @@ def response_figure(band: PredictiveBand, measured: np.ndarray, path: str | Path
         ax.set_xlabel("time (s)")
         ax.set_ylabel(ylabel)
     if misfit is not None:
-        _misfit_panel(axes[-1], misfit, ylabel[ylabel.rfind("("):] if "(" in ylabel else "")
+        _misfit_panel(axes[-1], misfit, ylabel[ylabel.rfind("("):] if "(" in ylabel else "",
+                      compare)
     save_figure(fig, path)
 
 
-def _misfit_panel(ax, m: StickMisfit, unit: str) -> None:
-    """Bars: the RMS of measured minus model mean per band of the rig's screw speed (truth),
-    each labelled with its share of the samples; the title gives the misfit near the sticks
-    over elsewhere, absolute and relative to the record there."""
-    labels = [f"{lo:g}-{hi:g}" if np.isfinite(hi) else f"> {lo:g}" for lo, hi, _, _ in
-              m.by_speed]
-    rms = [r for *_, r in m.by_speed]
-    bars = ax.bar(labels, rms, color=MODEL, alpha=0.6)
-    for bar, (_, _, share, _) in zip(bars, m.by_speed):
-        ax.annotate(f"{100 * share:.0f} %", (bar.get_x() + bar.get_width() / 2,
-                                             bar.get_height()), ha="center", va="bottom",
-                    fontsize=LEGEND_SIZE)
-    ax.set_xlabel("rig's screw speed |z'| (mm/s, truth); labels: share of the samples")
-    ax.set_ylabel(f"RMS of measured - mean {unit}".strip())
-    ax.set_title("where the model misses (the rig's truth): RMS misfit per band of screw speed\n"
-                 f"within 20 ms of its {m.sticks} sticks ({100 * m.near_share:.1f} % of the "
-                 f"samples): {m.absolute_ratio:.2f} x the misfit elsewhere, "
-                 f"{m.relative_ratio:.2f} x relative to the record there", fontsize=TITLE_SIZE)
+def _misfit_rows(m: StickMisfit) -> list[tuple[str, float, float, float]]:
+    """(label, share of the samples, RMS residual, RMS of the record): stuck, then the speed
+    bands while moving."""
+    return [("stuck", m.stuck_share, *m.stuck)] + [
+        (f"{lo:g}-{hi:g}" if np.isfinite(hi) else f"> {lo:g}", share, r, y)
+        for lo, hi, share, r, y in m.by_speed]
+
+
+def _misfit_panel(ax, m: StickMisfit, unit: str,
+                  compare: tuple[str, StickMisfit] | None = None) -> None:
+    """Bars: the RMS of measured minus model mean (dark) beside the record's own RMS (light)
+    while the rig is stuck and per band of its screw speed while it moves (truth), each
+    labelled with the misfit's share of the record there and the share of the samples;
+    ``compare``'s misfit hatched beside them. The title gives the shares stuck and moving,
+    and the misfit near the sticks over elsewhere."""
+    rows = _misfit_rows(m)
+    x = np.arange(len(rows))
+    w = 0.27 if compare else 0.4
+    res, rec = (np.nan_to_num([r[i] for r in rows]) for i in (2, 3))
+    ax.bar(x - w / 2, res, w, color=MODEL, alpha=0.7, label="RMS of measured - mean")
+    ax.bar(x + w / 2, rec, w, color=MEASURED, alpha=0.5, label="RMS of the record")
+    top = max(rec.max(), res.max())
+    if compare is not None:
+        other = np.nan_to_num([r[2] for r in _misfit_rows(compare[1])])
+        ax.bar(x + 1.5 * w, other, w, color="white", edgecolor=MODEL, hatch="///",
+               label=f"RMS of measured - mean, {compare[0]} (for comparison)")
+    for xi, (_, share, r, y) in zip(x, rows):
+        if share > 0:
+            ax.annotate(f"{100 * r / y:.0f} % of the record\n{100 * share:.1f} % of samples",
+                        (xi - w / 2, r), ha="center", va="bottom", fontsize=LEGEND_SIZE)
+    ax.set_xticks(x, [r[0] for r in rows])
+    ax.set_xlabel("the rig stuck, or moving at screw speed |z'| (mm/s; its truth)")
+    ax.set_ylabel(f"RMS {unit}".strip())
+    ax.set_ylim(0, 1.3 * top)
+    ax.legend(loc="upper left", fontsize=LEGEND_SIZE, frameon=False)
+    also = ("" if compare is None else f"; the {compare[0]} model's "
+            f"{100 * compare[1].stuck_nrmse:.0f} and {100 * compare[1].moving_nrmse:.0f} %")
+    ax.set_title(f"where the model misses (the rig's truth), as a share of the record there: "
+                 f"while the rig is stuck ({m.sticks} sticks, {100 * m.stuck_share:.1f} % of "
+                 f"the samples)\n{100 * m.stuck_nrmse:.0f} %, while it moves "
+                 f"{100 * m.moving_nrmse:.0f} %{also}; within 20 ms of the sticks "
+                 f"({100 * m.near_share:.1f} %): {m.absolute_ratio:.2f} x the misfit "
+                 f"elsewhere,\n{m.relative_ratio:.2f} x relative to the record there",
+                 fontsize=TITLE_SIZE)

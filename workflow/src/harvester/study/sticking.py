@@ -2,9 +2,10 @@
 
 The paper reads its Figure 7 as the linear model failing "where the device sticks". On the rig
 the truth says where it stuck and how fast the screw moved, so the claim can be measured: the
-model's residual (measured minus its mean) within ``near_s`` of a stick against elsewhere,
-absolutely and relative to the record's own RMS there (the record is smaller near a stick),
-and its RMS per band of screw speed. Used by Figure 7 and by
+model's residual (measured minus its mean) while the rig is stuck and within ``near_s`` of a
+stick against elsewhere, each also relative to the record's own RMS there (the record is
+smaller near a stick: a model that cannot stick misses a larger part of it there), and its
+RMS per band of screw speed over the moving samples. Used by Figure 7 and by
 ``benchmarks/bench_rig_session.py``.
 """
 
@@ -52,7 +53,8 @@ def longest_stick_window(stuck: np.ndarray, time: np.ndarray,
 
 @dataclass(frozen=True)
 class StickMisfit:
-    """A model's misfit near the rig's sticks against elsewhere, and per band of speed."""
+    """A model's misfit while the rig is stuck, near its sticks against elsewhere, and per
+    band of speed."""
 
     sticks: int
     longest_ms: float
@@ -62,15 +64,32 @@ class StickMisfit:
     absolute_ratio: float
     #: the same, each relative to the measured record's RMS there
     relative_ratio: float
-    #: (low, high mm/s, share of the samples, RMS residual) per speed band
-    by_speed: tuple[tuple[float, float, float, float], ...]
+    #: (RMS residual, RMS of the record) over the stuck samples
+    stuck: tuple[float, float]
+    #: (low, high mm/s, share of the samples, RMS residual, RMS of the record) per speed band
+    #: of the samples where the rig moves
+    by_speed: tuple[tuple[float, float, float, float, float], ...]
+
+    @property
+    def stuck_nrmse(self) -> float:
+        """RMS residual / RMS of the record while the rig is stuck."""
+        return self.stuck[0] / self.stuck[1]
+
+    @property
+    def moving_nrmse(self) -> float:
+        """RMS residual / RMS of the record while the rig moves (every band)."""
+        res = sum(share * r ** 2 for _, _, share, r, _ in self.by_speed if share > 0)
+        rec = sum(share * y ** 2 for _, _, share, _, y in self.by_speed if share > 0)
+        return float(np.sqrt(res / rec))
 
     def to_dict(self) -> dict:
         return {"sticks": self.sticks, "longest_stick_ms": round(self.longest_ms, 1),
                 "stuck_pct": round(100.0 * self.stuck_share, 2),
                 "near_stick_pct": round(100.0 * self.near_share, 2),
                 "rms_near_over_elsewhere": round(self.absolute_ratio, 3),
-                "nrmse_near_over_elsewhere": round(self.relative_ratio, 3)}
+                "nrmse_near_over_elsewhere": round(self.relative_ratio, 3),
+                "nrmse_stuck": round(self.stuck_nrmse, 3),
+                "nrmse_moving": round(self.moving_nrmse, 3)}
 
 
 def _rms(x: np.ndarray, mask: np.ndarray) -> float:
@@ -80,17 +99,20 @@ def _rms(x: np.ndarray, mask: np.ndarray) -> float:
 def stick_misfit(residual: np.ndarray, measured: np.ndarray, stuck: np.ndarray,
                  speed: np.ndarray, fs: float, near_s: float = NEAR_S) -> StickMisfit:
     """The misfit of ``residual`` (measured - model) on samples where the rig's truth gives
-    ``stuck`` and the screw ``speed`` (m/s); NaN ratios where there is no stick."""
+    ``stuck`` and the screw ``speed`` (m/s); the speed bands over the samples where it moves;
+    NaN ratios where there is no stick."""
     near = near_sticks(stuck, fs, near_s)
     starts, ends = stick_runs(stuck)
     far = ~near
     ratio = _rms(residual, near) / _rms(residual, far)
     relative = ratio / (_rms(measured, near) / _rms(measured, far))
     mm_s = 1e3 * np.abs(speed)
+    stuck = np.asarray(stuck, dtype=bool)
     bands = []
     for lo, hi in zip(SPEED_EDGES_MM_S[:-1], SPEED_EDGES_MM_S[1:]):
-        sel = (mm_s >= lo) & (mm_s < hi)
-        bands.append((lo, hi, float(sel.mean()), _rms(residual, sel)))
+        sel = (mm_s >= lo) & (mm_s < hi) & ~stuck
+        bands.append((lo, hi, float(sel.mean()), _rms(residual, sel), _rms(measured, sel)))
     return StickMisfit(int(starts.size), 1e3 * float((ends - starts).max(initial=0)) / fs,
                        float(np.mean(stuck)), float(near.mean()), float(ratio),
-                       float(relative), tuple(bands))
+                       float(relative), (_rms(residual, stuck), _rms(measured, stuck)),
+                       tuple(bands))

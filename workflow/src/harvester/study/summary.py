@@ -7,15 +7,19 @@ from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
+from scipy.stats import norm
 
 from harvester.study import paper
 
-COLUMNS = ["quantity", "paper", "ours", "truth", "unit"]
+COLUMNS = ["quantity", "paper", "ours", "truth", "unit", "note"]
 
 
 def headline_table(table1: pd.DataFrame, posteriors: Mapping[str, pd.DataFrame],
-                   bayes: pd.DataFrame, validation: pd.DataFrame) -> pd.DataFrame:
-    """Rows: Table 1 values, posterior means (Tables 3, 5), eq. (12), share outside 3 sigma."""
+                   bayes: pd.DataFrame, validation: pd.DataFrame,
+                   sticking: pd.DataFrame | None = None) -> pd.DataFrame:
+    """Rows: Table 1 values, posterior means (Tables 3, 5), eq. (12), share outside 3 sigma,
+    and Figure 7's misfit while the rig is stuck and while it moves (``sticking``: one row
+    per model of ``study.sticking.StickMisfit.to_dict``)."""
     rows = [{"quantity": f"Table 1: {r.parameter}", "paper": r.paper, "ours": r.value,
              "truth": r.truth, "unit": r.unit} for r in table1.itertuples()]
     for model, df in posteriors.items():
@@ -33,7 +37,61 @@ def headline_table(table1: pd.DataFrame, posteriors: Mapping[str, pd.DataFrame],
         rows.append({"quantity": f"tanh, unseen data: share outside 3 sd ({r.bounds} bounds)",
                      "paper": paper.OUTSIDE_3SIGMA_UNSEEN if r.bounds == "parameter" else np.nan,
                      "ours": r.outside_3sigma, "truth": np.nan, "unit": "fraction"})
+    for r in ([] if sticking is None else sticking.itertuples()):
+        rows.append({"quantity": f"Figure 7: {r.model} model's RMS misfit over the record's "
+                                 f"RMS, while the rig is stuck ({r.stuck_pct:g} % of the "
+                                 "samples) / while it moves",
+                     "paper": np.nan, "ours": f"{r.nrmse_stuck:.3g} / {r.nrmse_moving:.3g}",
+                     "truth": np.nan, "unit": ""})
     return pd.DataFrame(rows, columns=COLUMNS)
+
+
+def _sigma(df: pd.DataFrame) -> float:
+    return float(df.set_index("parameter").loc["sigma", "mean"])
+
+
+def what_cannot_hold(posteriors: Mapping[str, pd.DataFrame], log_bf: float,
+                     ensemble_ratio: float) -> dict[str, str]:
+    """Notes, by the start of the headline's quantity, on the paper's numbers that cannot
+    hold beside the others, computed from the paper's own numbers and ours (docs/design.md,
+    the virtual rig). ``log_bf``: our eq. (12); ``ensemble_ratio``: the tanh model's
+    parameter-ensemble sd over its RMS residual on the unseen record."""
+    n, p3, p5 = paper.TRAINING_SAMPLES, paper.TABLE3["sigma"], paper.TABLE5["sigma"]
+    lin, tanh = _sigma(posteriors["linear"]), _sigma(posteriors["tanh"])
+    c_m = float(posteriors["linear"].set_index("parameter").loc["c_m", "mean"])
+    need = norm.isf(paper.OUTSIDE_3SIGMA_UNSEEN / 2.0) / 3.0
+
+    def ours_l(a: float, b: float) -> float:  # eq. (10)'s likelihood ratio at two sigmas
+        return n * float(np.log(a / b))
+    return {
+        "Table 3 (linear): posterior mean sigma": (
+            f"cannot hold beside Table 3's c_m and Table 5's sigma: the paper's sigmas leave "
+            f"the linear model sqrt({p3}^2 - {p5}^2) = {np.sqrt(p3**2 - p5**2):.3f} m/s^2 of "
+            f"misfit beyond the tanh model's; at a linear c_m of {c_m:.0f} N s/m (paper "
+            f"{paper.TABLE3['c_m']}) the rig, with Table 5's friction, leaves "
+            f"{np.sqrt(max(lin**2 - tanh**2, 0.0)):.3f}"),
+        "eq. (12)": (
+            f"with the paper's sigmas and N = {n}, eq. (10) alone gives the tanh model "
+            f"N ln({p3} / {p5}) = {ours_l(p3, p5):.1f} nats over the linear one; "
+            f"{paper.LOG_BAYES_FACTOR_TANH_LINEAR} needs the priors and Occam factors to take "
+            f"{ours_l(p3, p5) - paper.LOG_BAYES_FACTOR_TANH_LINEAR:.1f} of them back, where "
+            f"ours add {log_bf - ours_l(lin, tanh):+.1f} (N ln({lin:.4g} / {tanh:.4g}) = "
+            f"{ours_l(lin, tanh):.1f} of our {log_bf:.1f})"),
+        "tanh, unseen data: share outside 3 sd (parameter": (
+            f"cannot hold with {n} independent residuals: the parameter ensemble's sd is "
+            f"{ensemble_ratio:.3f} x the residual's, so Gaussian residuals fall outside 3 of "
+            f"it in {2.0 * norm.sf(3.0 * ensemble_ratio):.1%} of the samples; "
+            f"{paper.OUTSIDE_3SIGMA_UNSEEN:.1%} needs {need:.2f} x"),
+    }
+
+
+def with_notes(table: pd.DataFrame, notes: Mapping[str, str]) -> pd.DataFrame:
+    """``table`` with each note on the rows whose quantity starts with its key."""
+    out = table.copy()
+    out["note"] = out["note"].astype(object)
+    for key, note in notes.items():
+        out.loc[out["quantity"].str.startswith(key), "note"] = note
+    return out
 
 
 def _interval_rows(number: str, model: str, df: pd.DataFrame) -> list[dict]:

@@ -1,0 +1,38 @@
+"""The headline's notes on the paper's numbers that cannot all hold (``study.summary``)."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from harvester.study.summary import COLUMNS, what_cannot_hold, with_notes
+
+
+def _posterior(c_m: float, sigma: float) -> pd.DataFrame:
+    return pd.DataFrame({"parameter": ["c_m", "sigma"], "mean": [c_m, sigma]})
+
+
+def test_the_notes_compute_the_paper_numbers_that_cannot_hold():
+    posts = {"linear": _posterior(430.0, 0.25), "tanh": _posterior(110.0, 0.1)}
+    notes = what_cannot_hold(posts, log_bf=1850.0, ensemble_ratio=0.03)
+    # eq. (10) with the paper's own sigmas and N = 2000
+    assert f"{2000 * np.log(0.1035 / 0.0956):.1f} nats" in notes["eq. (12)"]
+    assert "158.8 nats" in notes["eq. (12)"] and "134.6 of them back" in notes["eq. (12)"]
+    ours = 2000 * np.log(0.25 / 0.1)
+    assert f"{1850.0 - ours:+.1f}" in notes["eq. (12)"]
+    # misfit beyond the tanh model's: the paper's and ours
+    table3 = notes["Table 3 (linear): posterior mean sigma"]
+    assert "0.040 m/s^2" in table3 and f"{np.sqrt(0.25**2 - 0.1**2):.3f}" in table3
+    # Gaussian residuals outside +-3 x 0.03 of their sd; 1.3 % needs 0.83 x
+    share = notes["tanh, unseen data: share outside 3 sd (parameter"]
+    assert "92.8%" in share and "needs 0.83 x" in share
+
+
+def test_notes_land_on_the_rows_they_name_only():
+    table = pd.DataFrame([{"quantity": q, "paper": 1.0, "ours": 2.0, "truth": np.nan,
+                           "unit": "", "note": np.nan}
+                          for q in ("eq. (12): log Bayes factor tanh / linear", "Table 1: M")],
+                         columns=COLUMNS)
+    out = with_notes(table, {"eq. (12)": "why"})
+    assert out.note.tolist()[0] == "why" and pd.isna(out.note.tolist()[1])
+    assert pd.isna(table.note).all()  # the table passed in is not changed
+    assert pytest.approx(out.ours.tolist()) == [2.0, 2.0]
