@@ -504,3 +504,23 @@ def test_the_missing_force_is_the_effects_own_force_along_the_true_path():
     own = (0.3 * acc + 0.2 * run.base_internal())[window]
     mass = SimpleNamespace(kind=L.NONE, p=heavier, n_sub=2, context=ctx)
     assert L.missing_force_rms(run, mass) == pytest.approx(np.sqrt(np.mean(own**2)), rel=1e-9)
+
+
+def test_the_input_noise_can_be_the_recordings_own():
+    """Without shared input noise the base channel is the DAQ's clean base (the shared
+    record's base less the base sensor's noise), rel_acc keeps its noise level, and the
+    device, effect and missing force are the same."""
+    shared = L.generate("payload_error", 6, duration_s=6.0)
+    own = L.generate("payload_error", 6, duration_s=6.0, shared_input_noise=False)
+    assert shared.truth["shared_input_noise"] and not own.truth["shared_input_noise"]
+    assert own.truth["device"] == shared.truth["device"]
+    assert own.truth["missing_force_rms_N"] == pytest.approx(
+        shared.truth["missing_force_rms_N"], rel=0.02)
+    base_noise = (shared.recording.base_acc - own.recording.base_acc).to_numpy()
+    assert np.sqrt(np.mean(base_noise ** 2)) == pytest.approx(NOISE / np.sqrt(2.0), rel=0.1)
+    # rel_acc's noise: the same level, and no longer the negative of the base sensor's
+    rel_noise = (own.recording.rel_acc - own.clean_rel_acc).to_numpy()
+    assert np.sqrt(np.mean(rel_noise ** 2)) == pytest.approx(NOISE, rel=0.1)
+    assert abs(np.corrcoef(rel_noise, base_noise)[0, 1]) < 0.1
+    shared_noise = (shared.recording.rel_acc - shared.clean_rel_acc).to_numpy()
+    assert np.corrcoef(shared_noise, base_noise)[0, 1] < -0.6

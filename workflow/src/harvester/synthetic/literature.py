@@ -1386,7 +1386,8 @@ def _record(run: _Run, cal: _Calibrated, noise: tuple[np.ndarray, np.ndarray],
 
 def generate(name: str, seed: int, ratio: float = 0.5, duration_s: float = 40.0,
              fs: float = 256.0, noise_rel_acc: float = 0.09, lsb: float | None = None,
-             friction_form: str = "tanh") -> GeneratedRecording:
+             friction_form: str = "tanh", shared_input_noise: bool = True
+             ) -> GeneratedRecording:
     """A recording of a device drawn for ``seed`` with the scenario ``name``'s effect.
 
     The effect's contribution to the recorded rel_acc has RMS = ratio x the rel_acc noise's
@@ -1395,7 +1396,12 @@ def generate(name: str, seed: int, ratio: float = 0.5, duration_s: float = 40.0,
     channels, None for none. ``friction_form``: the device's smooth sign S ('tanh', the
     diagnosis's baseline law; 'atan', 'algebraic', or 'drawn' per seed); a form other than
     tanh is a second, unnamed departure from the baseline (its size is in the truth's
-    ``baseline_form_unabsorbed_to_noise``).
+    ``baseline_form_unabsorbed_to_noise``). ``shared_input_noise``: rel_acc is the mass
+    accelerometer less the base accelerometer, which is also the recorded input, so the base
+    sensor's noise is in both (a rig with two accelerometers); False: the base channel is
+    noise-free and the mass sensor carries sqrt(2) x its noise, the same rel_acc noise drawn
+    from the same stream but independent of the input (a relative sensor). The device, the
+    excitation and the effect are the same either way.
     """
     if name not in SCENARIOS:
         raise ValueError(f"unknown scenario {name!r}; known: {', '.join(SCENARIOS)}")
@@ -1406,6 +1412,8 @@ def generate(name: str, seed: int, ratio: float = 0.5, duration_s: float = 40.0,
     tb = TimeBase(fs, round(duration_s * fs))
     sensor = noise_rel_acc / np.sqrt(2.0)
     noise = (sensor_noise(rng_noise, sensor, tb.n_out), sensor_noise(rng_noise, sensor, tb.n_out))
+    if not shared_input_noise:
+        noise = (0.0 * noise[0], np.sqrt(2.0) * noise[1])
     noise_rms = _rms((noise[1] - noise[0])[tb.window])
     for device_draw in range(1, MAX_DEVICE_DRAWS + 1):
         device = draw_device(rng_device, noise_rel_acc, friction_form)
@@ -1429,6 +1437,7 @@ def generate(name: str, seed: int, ratio: float = 0.5, duration_s: float = 40.0,
     truth["input_driven_to_clean_contribution"] = (
         _rms((driven - contribution)[tb.window]) / max(_rms(contribution[tb.window]), 1e-300))
     truth["missing_force_rms_N"] = missing_force_rms(run, cal)
+    truth["shared_input_noise"] = bool(shared_input_noise)
     return GeneratedRecording(recording, sidecar, truth, contribution, cal.with_effect,
                               cal.baseline, driven)
 
