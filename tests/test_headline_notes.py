@@ -4,7 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from harvester.study.summary import COLUMNS, what_cannot_hold, with_notes
+from harvester.study.summary import COLUMNS, figure7_notes, what_cannot_hold, with_notes
 
 
 def _posterior(c_m: float, sigma: float) -> pd.DataFrame:
@@ -36,3 +36,17 @@ def test_notes_land_on_the_rows_they_name_only():
     assert out.note.tolist()[0] == "why" and pd.isna(out.note.tolist()[1])
     assert pd.isna(table.note).all()  # the table passed in is not changed
     assert pytest.approx(out.ours.tolist()) == [2.0, 2.0]
+
+
+def test_figure7_notes_read_the_sticking_table():
+    rows = pd.DataFrame([
+        {"model": "linear", "nrmse_stuck": 0.83, "nrmse_moving": 0.28, "rms_stuck": 0.157,
+         "rms_moving": 0.27, "rms_fastest_band": 0.52},
+        {"model": "tanh", "nrmse_stuck": 0.51, "nrmse_moving": 0.10, "rms_stuck": 0.097,
+         "rms_moving": 0.095, "rms_fastest_band": 0.1}])
+    notes = figure7_notes(rows)
+    assert "misses 83% of the record while the rig is stuck against 28%" in notes[
+        "Figure 7: linear"] and "(0.52 in the fastest band, 0.157 stuck)" in notes[
+        "Figure 7: linear"]
+    assert "(0.097 and 0.095 m/s^2)" in notes["Figure 7: tanh"]
+    assert figure7_notes(rows.iloc[:1]) == {}

@@ -39,6 +39,7 @@ def test_a_misfit_made_near_the_sticks_reads_above_one_and_by_speed():
     moving = ~stuck
     expected = np.sqrt(np.mean(residual[moving] ** 2) / np.mean(measured[moving] ** 2))
     assert m.moving_nrmse == pytest.approx(expected)
+    assert m.moving[0] == pytest.approx(np.sqrt(np.mean(residual[moving] ** 2)))
 
 
 def test_the_zoom_is_centred_on_the_longest_stick_and_kept_inside():

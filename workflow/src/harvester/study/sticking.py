@@ -76,11 +76,17 @@ class StickMisfit:
         return self.stuck[0] / self.stuck[1]
 
     @property
-    def moving_nrmse(self) -> float:
-        """RMS residual / RMS of the record while the rig moves (every band)."""
+    def moving(self) -> tuple[float, float]:
+        """(RMS residual, RMS of the record) while the rig moves (every band)."""
+        w = sum(share for _, _, share, _, _ in self.by_speed if share > 0)
         res = sum(share * r ** 2 for _, _, share, r, _ in self.by_speed if share > 0)
         rec = sum(share * y ** 2 for _, _, share, _, y in self.by_speed if share > 0)
-        return float(np.sqrt(res / rec))
+        return float(np.sqrt(res / w)), float(np.sqrt(rec / w))
+
+    @property
+    def moving_nrmse(self) -> float:
+        """RMS residual / RMS of the record while the rig moves (every band)."""
+        return self.moving[0] / self.moving[1]
 
     def to_dict(self) -> dict:
         return {"sticks": self.sticks, "longest_stick_ms": round(self.longest_ms, 1),
@@ -89,7 +95,9 @@ class StickMisfit:
                 "rms_near_over_elsewhere": round(self.absolute_ratio, 3),
                 "nrmse_near_over_elsewhere": round(self.relative_ratio, 3),
                 "nrmse_stuck": round(self.stuck_nrmse, 3),
-                "nrmse_moving": round(self.moving_nrmse, 3)}
+                "nrmse_moving": round(self.moving_nrmse, 3),
+                "rms_stuck": round(self.stuck[0], 4), "rms_moving": round(self.moving[0], 4),
+                "rms_fastest_band": round(self.by_speed[-1][3], 4)}
 
 
 def _rms(x: np.ndarray, mask: np.ndarray) -> float:

@@ -85,6 +85,27 @@ def what_cannot_hold(posteriors: Mapping[str, pd.DataFrame], log_bf: float,
     }
 
 
+def figure7_notes(sticking: pd.DataFrame) -> dict[str, str]:
+    """Notes on Figure 7's rows (``sticking``: one row per model of
+    ``study.sticking.StickMisfit.to_dict``, the linear model's and the tanh model's): what
+    each model misses while the rig is stuck against while it moves."""
+    by = sticking.set_index("model")
+    if not {"linear", "tanh"} <= set(by.index):
+        return {}
+    lin, tanh = by.loc["linear"], by.loc["tanh"]
+    return {
+        "Figure 7: linear": (
+            f"the paper's reading, measured: the linear model, which cannot stick, misses "
+            f"{lin.nrmse_stuck:.0%} of the record while the rig is stuck against "
+            f"{lin.nrmse_moving:.0%} while it moves; in m/s^2 its misfit is largest at speed "
+            f"({lin.rms_fastest_band:.3g} in the fastest band, {lin.rms_stuck:.3g} stuck)"),
+        "Figure 7: tanh": (
+            f"its misfit is its noise level stuck and moving ({tanh.rms_stuck:.3g} and "
+            f"{tanh.rms_moving:.3g} m/s^2): the share while stuck is the noise's share of the "
+            "small record there"),
+    }
+
+
 def with_notes(table: pd.DataFrame, notes: Mapping[str, str]) -> pd.DataFrame:
     """``table`` with each note on the rows whose quantity starts with its key."""
     out = table.copy()
@@ -124,6 +145,8 @@ def headline_html(df: pd.DataFrame) -> str:
     return ("<!DOCTYPE html><html><head><meta charset='utf-8'><title>Headline numbers</title>"
             "<style>td,th{padding:2px 8px;border-bottom:1px solid #ddd;text-align:left}</style>"
             "</head><body><h2>Green et al. (2015) reproduced on a SIMULATED virtual rig</h2>"
-            "<p>The recordings come from the study's virtual rig, not the paper's device; "
-            "'truth' is the rig's ground truth.</p>"
+            "<p>The recordings come from the study's virtual rig, not the paper's device, "
+            "calibrated to the paper's statistics (docs/design.md); 'truth' is the rig's "
+            "ground truth. Where one of the paper's numbers cannot hold beside its others, "
+            "the note says why, computed from the paper's numbers and ours.</p>"
             f"<table><tr>{head}</tr>{body}</table></body></html>\n")
