@@ -54,3 +54,52 @@ def test_the_gain_rises_from_the_floor_to_its_spread():
     floor = NoiseFloor(1.0, (0.1, 90.0), 0.9, 100.0)
     g = input_gain(np.zeros(4), np.array([0.5, 1.5, 2.0, 3.0]), floor)
     assert g[0] == g[1] == 0.0 and g[3] == 1.0 and 0.0 < g[2] < 1.0
+
+
+def _two_sensor_record(output_noise, seed=0, fs=256.0, n=10240):
+    """A low-frequency multisine base input with its sensor's white noise n0, and an output
+    of the device's response plus ``output_noise(n0, n1)``."""
+    from scipy import signal
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / fs
+    exc = sum(np.sin(2 * np.pi * f0 * t + rng.uniform(0, 6.3)) for f0 in np.arange(0.5, 3.0, 0.25))
+    n0, n1 = 0.064 * rng.standard_normal((2, n))
+    resp = 0.3 * signal.sosfilt(signal.butter(2, 3.0, fs=fs, output="sos"), exc)
+    return exc + n0, resp + output_noise(n0, n1), fs
+
+
+def test_an_output_formed_with_the_inputs_sensor_holds_its_noise():
+    """Two accelerometers (rel = mass - base): gain -1, coherence 0.5 where the input is its
+    noise alone; a relative sensor of its own: none; real base motion on the floor seen
+    through the device above resonance (-m/M = -0.9) is not taken for a shared sensor where
+    m/M is known."""
+    from harvester.data.input_noise import noise_floor, shared_noise
+    u, y, fs = _two_sensor_record(lambda n0, n1: n1 - n0)
+    floor = noise_floor(u, fs, 100.0)
+    two = shared_noise(u, y, fs, floor)
+    assert two.gain == pytest.approx(-1.0, abs=0.05) and two.coherence == pytest.approx(
+        0.5, abs=0.05) and two.shared() and two.shared(0.6)
+    u, y, fs = _two_sensor_record(lambda n0, n1: np.sqrt(2.0) * n1)
+    own = shared_noise(u, y, fs, noise_floor(u, fs, 100.0))
+    assert own.coherence < 0.05 and not own.shared()
+    u, y, fs = _two_sensor_record(lambda n0, n1: -0.9 * n0 + 0.2 * n1)
+    base_motion = shared_noise(u, y, fs, noise_floor(u, fs, 100.0))
+    assert base_motion.shared() and not base_motion.shared(0.9)
+
+
+def test_a_named_mass_error_on_such_a_record_is_said_not_fixed():
+    """The diagnosis's note: only where an effect of the masses is named or tied and the
+    output holds the input sensor's noise."""
+    from types import SimpleNamespace
+
+    from harvester.data.input_noise import SharedNoise
+    from harvester.diagnosis.run import mass_size_caveat
+    shared = SimpleNamespace(shared_input_noise=SharedNoise(-1.0, 0.45, 240))
+    own = SimpleNamespace(shared_input_noise=None)
+    tie = SimpleNamespace(effects=["inertia_error", "unmodelled_mode"])
+    named = SimpleNamespace(missing=["inertia_error"], ties=[])
+    tied = SimpleNamespace(missing=[], ties=[tie])
+    other = SimpleNamespace(missing=["cubic_stiffness"], ties=[])
+    assert mass_size_caveat(shared, named).startswith("inertia_error: the record does not fix")
+    assert mass_size_caveat(shared, tied).startswith("inertia_error:")
+    assert mass_size_caveat(shared, other) is None and mass_size_caveat(own, named) is None

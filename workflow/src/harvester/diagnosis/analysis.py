@@ -20,7 +20,8 @@ import pandas as pd
 
 from harvester.data.daq import RECORDING_COLUMNS
 from harvester.data.errors import DataError
-from harvester.data.input_noise import NoiseFloor, noise_floor, without_floor
+from harvester.data.input_noise import (NoiseFloor, SharedNoise, noise_floor, shared_noise,
+                                       without_floor)
 from harvester.data.signals import resample_recording, resampling_ratio, uniform_step
 from harvester.diagnosis.baseline import ChainProblem, baseline_state, chain_problem, fit_map
 from harvester.diagnosis.confirm import fit_structure, map_reference
@@ -131,6 +132,8 @@ class Analysis:
     fit_raw: Problem
     notes: list[str] = field(default_factory=list)
     input_floor: NoiseFloor | None = None  # the base channel's noise floor, where it shows one
+    #: where the output holds the input sensor's noise (``input_noise.shared_noise``)
+    shared_input_noise: SharedNoise | None = None
 
     @property
     def time(self) -> np.ndarray:
@@ -175,9 +178,11 @@ def prepare(recording: pd.DataFrame, validation: pd.DataFrame | None,
     rec, validation, dt, notes = resample_for_model(rec, validation, dt, lowpass)
     notes[:0] = kind_notes
     fs, n = 1.0 / dt, len(rec)
-    floor = None
+    floor, shared = None, None
     if settings.denoise_input:
+        raw = rec
         rec, validation, floor = model_input(rec, validation, fs, band_top(fs, lowpass), notes)
+        shared = input_noise_in_output(raw, fs, floor, known, notes)
     lead, hold, end = analysis_window(n, fs, settings.lead_in_s,
                                       0.0 if validation is not None else
                                       settings.holdout_fraction)
@@ -188,7 +193,7 @@ def prepare(recording: pd.DataFrame, validation: pd.DataFrame | None,
     base = detection_raw.structure
     out = Analysis(rec, validation, base, dict(known), dt, lowpass, settings.filter_order,
                    lead, hold, fit_stop, end, detection_raw,
-                   make_problem(rec, base, known, window=(lead, fit_stop)), notes, floor)
+                   make_problem(rec, base, known, window=(lead, fit_stop)), notes, floor, shared)
     t = out.time
     said = f"{lowpass:.1f} Hz" if lowpass else \
         "none found" if settings.lowpass_hz is None else "none (given)"
@@ -233,6 +238,29 @@ def model_input(rec: pd.DataFrame, validation: pd.DataFrame | None, fs: float, f
     log.info("%s", line)
     notes.append(line)
     return out[0], out[1], floor
+
+
+def input_noise_in_output(rec: pd.DataFrame, fs: float, floor: NoiseFloor | None,
+                          known: Mapping[str, float], notes: list[str]) -> SharedNoise | None:
+    """Where the input shows a noise floor: the output's share of that noise
+    (``input_noise.shared_noise``, on the recording as recorded), with a note where the
+    output holds it with gain -1 (a difference with the input's own sensor; ``known``'s m / M
+    where given, for a base input)."""
+    if floor is None:
+        return None
+    name, output = rec.columns[1], rec.columns[2]
+    found = shared_noise(rec[name].to_numpy(), rec[output].to_numpy(), fs, floor)
+    ratio = known["m"] / known["M"] if name == "base_acc" and known.get("M") and \
+        known.get("m") is not None else None
+    if found is None or not found.shared(ratio):
+        return None
+    line = (f"{output} holds {name}'s sensor noise where {name} is noise alone (gain "
+            f"{found.gain:.2f}, coherence {found.coherence:.2f} over {found.bins} bins): it is "
+            "a difference with the input's own sensor, and an effect of the masses read from "
+            "it is biased by that noise (errors in variables)")
+    log.info("%s", line)
+    notes.append(line)
+    return found
 
 
 def default_priors(structure: ModelStructure, sigma: float, unit: str = "m/s^2"

@@ -42,12 +42,29 @@ from harvester.inference.problems import make_problem
 from harvester.inference.priors import PriorSpec
 from harvester.model.structures import ModelStructure
 from harvester.model.structures import structure as named_structure
+from harvester.model.terms import term
 
 __all__ = ["Diagnosis", "DiagnosisSettings", "check_recording", "decide_verdict",
            "default_priors", "diagnose", "diagnose_study", "quick_detect",
            "resample_for_model", "velocity_bound", "write"]
 
 log = logging.getLogger("harvester.diagnosis")
+
+
+def mass_size_caveat(analysis: Analysis, diag: "Diagnosis") -> str | None:
+    """Where an effect of the masses is named or tied on a record whose output holds the
+    input sensor's noise (``analysis.shared_input_noise``): that its size is not fixed by the
+    record (errors in variables; on the literature grid's mass-error records its dM lay
+    2.0-4.9 posterior sds from the truth, within 1 sd without the shared noise)."""
+    names = list(diag.missing) + [e for t in diag.ties for e in t.effects]
+    mass = sorted({n for n in names if term(n).kind == "inertia"})
+    if analysis.shared_input_noise is None or not mass:
+        return None
+    return (f"{', '.join(mass)}: the record does not fix its size; its output holds the "
+            "input sensor's noise, which biases a mass error's dM and m_share (errors in "
+            "variables: on the literature grid's mass-error records by 2-5 posterior sds, "
+            "docs/measurements.md); a relative sensor, or an output sensor independent of the "
+            "input's, would fix it")
 
 
 @dataclass
@@ -133,6 +150,10 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
                       settings, analysis.notes + passes.notes + found.notes + passes.more,
                       time.perf_counter() - clock)
     diag.missing_force = missing
+    caveat = mass_size_caveat(analysis, diag)
+    if caveat:
+        log.info("%s", caveat)
+        diag.notes.append(caveat)
     log.info("verdict: %s%s (%.0f s)", diag.headline,
              "".join(f"; cannot tell apart {' / '.join(t.effects)}" for t in diag.ties),
              diag.seconds)
