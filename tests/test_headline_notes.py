@@ -50,3 +50,27 @@ def test_figure7_notes_read_the_sticking_table():
         "Figure 7: linear"]
     assert "(0.097 and 0.095 m/s^2)" in notes["Figure 7: tanh"]
     assert figure7_notes(rows.iloc[:1]) == {}
+
+
+def test_the_headline_notes_read_the_ensemble_from_the_unseen_band():
+    """The parameter ensemble's sd over the residual's RMS, from the band: an ensemble of sd
+    0.03 exactly about the record's mean, a residual of RMS 1 exactly."""
+    from harvester.inference.predictive import PredictiveBand
+    from harvester.study.summary import headline_notes
+    rng = np.random.default_rng(0)
+    t = np.arange(4000) / 256.0
+    signal = np.sin(2 * np.pi * t)
+    z = rng.standard_normal((400, t.size))
+    z = (z - z.mean(axis=0)) / z.std(axis=0, ddof=1)
+    band = PredictiveBand(t, signal + 0.03 * z, np.full(400, 1.0))
+    r = rng.standard_normal(t.size)
+    measured = signal + r / np.sqrt(np.mean(r ** 2))
+    posts = {"linear": _posterior(430.0, 0.25), "tanh": _posterior(110.0, 0.1)}
+    bayes = pd.DataFrame({"model": ["tanh"], "log_bayes_factor": [1850.0]})
+    sticking = pd.DataFrame([
+        {"model": m, "nrmse_stuck": 0.5, "nrmse_moving": 0.1, "rms_stuck": 0.1,
+         "rms_moving": 0.1, "rms_fastest_band": 0.1} for m in ("linear", "tanh")])
+    notes = headline_notes(posts, bayes, band, measured, sticking)
+    assert "the parameter ensemble's sd is 0.030 x" in notes[
+        "tanh, unseen data: share outside 3 sd (parameter"]
+    assert set(notes) >= {"eq. (12)", "Figure 7: linear", "Figure 7: tanh"}

@@ -23,9 +23,9 @@ has no floor to find, and its model input is left as recorded: there the noise i
 share of every line, and a floor fitted to a flat excitation would take away signal.
 
 The remedy leaves the noise within the excitation's band, where it still biases what the
-input's own share of the output fixes: a mass error's dM and m_share lay 1.7-4.9 posterior
-sds from the truth on the literature grid's mass-error records, and within 1 sd on the same
-records with the output's noise its own (docs/measurements.md). :func:`shared_noise` says
+input's own share of the output fixes: a named mass error's dM lay 0.6-2.4 posterior sds
+from the truth on six of the literature grid's mass-error records (4.9 on another), and within
+0.8 sd on the same records with the output's noise its own (docs/measurements.md). :func:`shared_noise` says
 whether a record is of that kind: on the floor's bins, where the input is its sensor's noise
 alone, an output formed as a difference with that sensor holds the same noise with gain -1.
 """

@@ -64,8 +64,9 @@ class StickMisfit:
     absolute_ratio: float
     #: the same, each relative to the measured record's RMS there
     relative_ratio: float
-    #: (RMS residual, RMS of the record) over the stuck samples
+    #: (RMS residual, RMS of the record) over the stuck samples, and over the moving ones
     stuck: tuple[float, float]
+    moving: tuple[float, float]
     #: (low, high mm/s, share of the samples, RMS residual, RMS of the record) per speed band
     #: of the samples where the rig moves
     by_speed: tuple[tuple[float, float, float, float, float], ...]
@@ -74,14 +75,6 @@ class StickMisfit:
     def stuck_nrmse(self) -> float:
         """RMS residual / RMS of the record while the rig is stuck."""
         return self.stuck[0] / self.stuck[1]
-
-    @property
-    def moving(self) -> tuple[float, float]:
-        """(RMS residual, RMS of the record) while the rig moves (every band)."""
-        w = sum(share for _, _, share, _, _ in self.by_speed if share > 0)
-        res = sum(share * r ** 2 for _, _, share, r, _ in self.by_speed if share > 0)
-        rec = sum(share * y ** 2 for _, _, share, _, y in self.by_speed if share > 0)
-        return float(np.sqrt(res / w)), float(np.sqrt(rec / w))
 
     @property
     def moving_nrmse(self) -> float:
@@ -123,4 +116,4 @@ def stick_misfit(residual: np.ndarray, measured: np.ndarray, stuck: np.ndarray,
     return StickMisfit(int(starts.size), 1e3 * float((ends - starts).max(initial=0)) / fs,
                        float(np.mean(stuck)), float(near.mean()), float(ratio),
                        float(relative), (_rms(residual, stuck), _rms(measured, stuck)),
-                       tuple(bands))
+                       (_rms(residual, ~stuck), _rms(measured, ~stuck)), tuple(bands))

@@ -4,12 +4,16 @@ from __future__ import annotations
 
 import html
 from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
 from scipy.stats import norm
 
 from harvester.study import paper
+
+if TYPE_CHECKING:  # the headline's tables are read without the simulator's import
+    from harvester.inference.predictive import PredictiveBand
 
 COLUMNS = ["quantity", "paper", "ours", "truth", "unit", "note"]
 
@@ -104,6 +108,18 @@ def figure7_notes(sticking: pd.DataFrame) -> dict[str, str]:
             f"{tanh.rms_moving:.3g} m/s^2): the share while stuck is the noise's share of the "
             "small record there"),
     }
+
+
+def headline_notes(posteriors: Mapping[str, pd.DataFrame], bayes: pd.DataFrame,
+                   unseen: PredictiveBand, measured: np.ndarray,
+                   sticking: pd.DataFrame) -> dict[str, str]:
+    """Every note of the headline: :func:`what_cannot_hold` with our eq. (12) from ``bayes``
+    and the tanh model's parameter-ensemble sd over its RMS residual on the ``unseen`` record
+    (its band and the ``measured`` output), and :func:`figure7_notes`."""
+    ratio = float(np.sqrt(np.mean(unseen.sd_parameter ** 2))
+                  / np.sqrt(np.mean((measured - unseen.mean) ** 2)))
+    log_bf = float(bayes.set_index("model").loc["tanh", "log_bayes_factor"])
+    return {**what_cannot_hold(posteriors, log_bf, ratio), **figure7_notes(sticking)}
 
 
 def with_notes(table: pd.DataFrame, notes: Mapping[str, str]) -> pd.DataFrame:
