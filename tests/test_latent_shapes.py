@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from scipy import optimize
 
-from latent_records import linear_state, recording, rk4_record
+from latent_records import FS, LOWPASS_HZ, linear_state, recording, rk4_record
 from harvester.diagnosis.latent import latent_force
 from harvester.diagnosis.shapes import describe, library_terms
 from harvester.model.terms import TERMS, is_friction
@@ -293,6 +293,18 @@ def test_a_named_terms_own_force_is_sized_with_its_interval():
         mid, lo, hi = term_force_rms(state.problem, improved, samples, "coulomb_friction")
         assert lo < mid < hi and (lo <= rms_true <= hi) == holds, (lo, rms_true, hi)
     assert parameter_values(improved, samples[0], {"M": 1.0})["F_coulomb"] == samples[0, 1]
+    # the diagnosis's problem stops 0.5 s after its analysed window: given the whole
+    # record's input, the span is the record's, as if the problem had held it all
+    from harvester.diagnosis.baseline import chain_problem
+    full = term_force_rms(state.problem, improved, samples, "coulomb_friction")
+    cut = chain_problem(dataclasses.replace(state.problem, window=(state.problem.window[0],
+                                                                   int(6.0 * FS))),
+                        lowpass_hz=LOWPASS_HZ)
+    assert len(cut.input) < len(state.problem.input)
+    again = term_force_rms(cut, improved, samples, "coulomb_friction",
+                           record_input=state.problem.input)
+    shorter = term_force_rms(cut, improved, samples, "coulomb_friction")
+    assert again == pytest.approx(full, rel=1e-9) and shorter != pytest.approx(full, rel=1e-6)
 
 
 def test_a_term_whose_strength_trades_against_the_baseline_is_said_on_a_ridge():

@@ -67,11 +67,13 @@ def missing_force(state: BaselineState, window: tuple[int, int] | None = None,
                   named: Sequence[NamedEffect] = (), unseen_input: np.ndarray | None = None,
                   unseen_window: slice | None = None, floor: RelevanceFloor = RelevanceFloor(),
                   out_dir: str | Path | None = None, units: Units = SI,
-                  **latent_kwargs) -> MissingForce:
+                  record_input: np.ndarray | None = None, **latent_kwargs) -> MissingForce:
     """Everything of the missing force for a baseline ``state`` (module docstring);
     ``unseen_input`` (the held-out or validation input, ``unseen_window`` of it) gives each
-    named effect's change of the predicted response; ``units``: the recording's (the labels
-    of every size, ``data.units``); figures in ``out_dir`` if given."""
+    named effect's change of the predicted response; ``record_input`` (the whole record's
+    input; default the state's, cut after its window) the span of each named term's own
+    force (``term_force_rms``); ``units``: the recording's (the labels of every size,
+    ``data.units``); figures in ``out_dir`` if given."""
     lf = latent_force(state, window, units=units, **latent_kwargs)
     desc = describe(lf)
     out = MissingForce(lf, desc, views(lf), residual_line=residual_line(lf))
@@ -85,7 +87,8 @@ def missing_force(state: BaselineState, window: tuple[int, int] | None = None,
         own, on_ridge = None, None
         if effect.samples is not None:
             sized = effect.sized or effect.structure
-            own = term_force_rms(state.problem, sized, effect.samples, effect.term)
+            own = term_force_rms(state.problem, sized, effect.samples, effect.term,
+                                 record_input=record_input)
             on_ridge = ridge(sized, effect.samples, effect.term)
         out.effects.append(ef)
         out.sizes.append(effect_size(lf, ef, floor, response, desc.share_of(ef.change), own,

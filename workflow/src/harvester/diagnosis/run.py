@@ -54,17 +54,18 @@ log = logging.getLogger("harvester.diagnosis")
 def mass_size_caveat(analysis: Analysis, diag: "Diagnosis") -> str | None:
     """Where an effect of the masses is named or tied on a record whose output holds the
     input sensor's noise (``analysis.shared_input_noise``): that its size is not fixed by the
-    record (errors in variables: on six of the literature grid's mass-error records its force
-    interval held the truth once, its dM 0.6-2.4 posterior sds away; made again without the
-    shared noise, 0.2-0.8 sd, docs/measurements.md)."""
+    record (errors in variables: on six of the literature grid's mass-error records its dM
+    lay 0.6-2.4 posterior sds from the truth and its force interval missed it on the two
+    1.9-2.4 sd away; made again without the shared noise, 0.2-0.8 sd, every interval held
+    it, docs/measurements.md)."""
     names = list(diag.missing) + [e for t in diag.ties for e in t.effects]
     mass = sorted({n for n in names if term(n).kind == "inertia"})
     if analysis.shared_input_noise is None or not mass:
         return None
     return (f"{', '.join(mass)}: the record does not fix its size; its output holds the "
             "input sensor's noise, which biases a mass error's dM and m_share (errors in "
-            "variables: on six of the literature grid's mass-error records the force's "
-            "interval held the truth once, docs/measurements.md); a relative sensor, or an "
+            "variables: on six of the literature grid's mass-error records dM lay up to 2.4 "
+            "posterior sds from the truth, docs/measurements.md); a relative sensor, or an "
             "output sensor independent of the input's, would fix it")
 
 
@@ -248,6 +249,7 @@ def estimate_missing_force(a: Analysis, state: BaselineState, found: Conclusion,
                                            settings.relevance_share,
                                            settings.relevance_share > 0),
                             units=settings.units,
+                            record_input=a.recording.iloc[:, 1].to_numpy(),
                             noise_floor=None if floor is None else floor.rms)
     # a coupling term (backlash) has no force on the mass alone (term_forces); a model that
     # cannot be simulated at its posterior mean or on the unseen input (latent, relevance);
