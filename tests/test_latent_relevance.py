@@ -115,3 +115,23 @@ def test_one_named_effect_is_sized_by_its_own_force_in_the_headline():
                                  missing=["end_stop", "cubic_stiffness"], ties=[]),
                  SimpleNamespace(sizes=[size, size]))
     assert "(together 9.97 N RMS, 371.00% of the drive, relevant)" in two
+
+
+def test_an_own_forces_share_of_the_drive_is_over_its_own_span():
+    """relevance.drive_rms over another input, and effect_size's own_drive_N: the share of
+    the drive the headline gives a term's own force is of the drive over the same span (the
+    record after the lead-in), while the force along the states keeps the window's."""
+    from types import SimpleNamespace
+
+    from harvester.diagnosis.relevance import EffectSize, RelevanceFloor, drive_rms, effect_size
+    window = np.full(100, 2.0)
+    from harvester.data.units import SI
+    lf = SimpleNamespace(values={"m": 0.5}, input_kind="base_acc", input=window, units=SI)
+    assert drive_rms(lf) == pytest.approx(1.0)
+    assert drive_rms(lf, np.full(50, 4.0)) == pytest.approx(2.0)
+    ef = SimpleNamespace(term="inertia_error", rms_N=0.1, share=0.2)
+    for own, drive in ((None, 1.0), (2.0, 2.0)):
+        size = effect_size(lf, ef, RelevanceFloor(), term_rms=(0.3, 0.25, 0.35),
+                           own_drive_N=own)
+        assert isinstance(size, EffectSize) and size.share_of_drive == pytest.approx(0.1)
+        assert size.own_share_of_drive == pytest.approx(0.3 / drive)

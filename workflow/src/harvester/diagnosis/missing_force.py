@@ -16,7 +16,7 @@ from harvester.diagnosis.baseline import BaselineState
 from harvester.diagnosis.latent import LatentForce, latent_force
 from harvester.diagnosis.latent_views import Binned, EffectForce, effect_force, views
 from harvester.diagnosis.lines import ResidualLine, residual_line
-from harvester.diagnosis.relevance import (EffectSize, RelevanceFloor, effect_size,
+from harvester.diagnosis.relevance import (EffectSize, RelevanceFloor, drive_rms, effect_size,
                                            response_change, ridge, term_force_rms)
 from harvester.diagnosis.shapes import ShapeDescription, describe
 from harvester.model.structures import ModelStructure
@@ -77,6 +77,9 @@ def missing_force(state: BaselineState, window: tuple[int, int] | None = None,
     lf = latent_force(state, window, units=units, **latent_kwargs)
     desc = describe(lf)
     out = MissingForce(lf, desc, views(lf), residual_line=residual_line(lf))
+    # the drive over the named terms' own forces' span (term_force_rms), for their share
+    span_drive = None if record_input is None else \
+        drive_rms(lf, np.asarray(record_input)[state.problem.window[0]:])
     for effect in named:
         ef = effect_force(lf, effect.structure, effect.theta, state.problem.known, effect.term)
         response = None
@@ -92,7 +95,7 @@ def missing_force(state: BaselineState, window: tuple[int, int] | None = None,
             on_ridge = ridge(sized, effect.samples, effect.term)
         out.effects.append(ef)
         out.sizes.append(effect_size(lf, ef, floor, response, desc.share_of(ef.change), own,
-                                     on_ridge, effect.adjusted))
+                                     on_ridge, effect.adjusted, span_drive))
     if out_dir is not None:
         from harvester.diagnosis.latent_figures import all_latent_figures
         out.figure_files = all_latent_figures(lf, desc, out_dir, out.effects,

@@ -79,7 +79,8 @@ class EffectSize:
     ridge: tuple[str, float] | None = None
     #: whether the interval's posterior was adjusted for correlated residuals
     interval_adjusted: bool = False
-    #: RMS of the drive (m y'' or F) the shares of the drive are of
+    #: RMS of the drive (m y'' or F) the own force's share of the drive is of, over the
+    #: same span as the own force (:func:`term_force_rms`)
     drive_rms_N: float | None = None
 
     @property
@@ -133,10 +134,12 @@ class EffectSize:
                 "sentence": self.sentence()}
 
 
-def drive_rms(lf: LatentForce) -> float:
-    """RMS of the force that drives the device (N): m y'' for a base input, F for a force."""
+def drive_rms(lf: LatentForce, input: np.ndarray | None = None) -> float:
+    """RMS of the force that drives the device (N): m y'' for a base input, F for a force;
+    over the latent force's window, or over ``input`` (the same kind) where given."""
     gain = lf.values.get("m", 0.0) if lf.input_kind == "base_acc" else 1.0
-    return float(max(np.sqrt(np.mean((gain * lf.input) ** 2)), 1e-12))
+    u = lf.input if input is None else np.asarray(input, dtype=float)
+    return float(max(np.sqrt(np.mean((gain * u) ** 2)), 1e-12))
 
 
 def response_change(problem, theta: np.ndarray, improved: ModelStructure,
@@ -223,12 +226,13 @@ def effect_size(lf: LatentForce, ef: EffectForce, floor: RelevanceFloor = Releva
                 share_of_missing: float | None = None,
                 term_rms: tuple[float, float, float] | None = None,
                 on_ridge: tuple[str, float] | None = None,
-                adjusted: bool = False) -> EffectSize:
+                adjusted: bool = False, own_drive_N: float | None = None) -> EffectSize:
     """The named effect's size from its force beside the latent force (``ef``) and, if
     given, its ``response`` change on unseen data (:func:`response_change`), its share as
     the shapes read theirs, its own force's RMS (:func:`term_force_rms`) and the ridge its
     strength lies on (:func:`ridge`), and whether that interval's posterior was adjusted for
-    correlated residuals (``adjusted``); labelled in ``lf.units``."""
+    correlated residuals (``adjusted``); labelled in ``lf.units``. ``own_drive_N``: the
+    drive's RMS over the own force's span (default: over the window, as the shares)."""
     drive = drive_rms(lf)
     share = ef.rms_N / drive
     small_response = response is None or response[1] < floor.response_share
@@ -237,4 +241,5 @@ def effect_size(lf: LatentForce, ef: EffectForce, floor: RelevanceFloor = Releva
                       None if response is None else response[0],
                       None if response is None else response[1], negligible, floor, lf.units,
                       share_of_missing, None if term_rms is None else term_rms[0],
-                      None if term_rms is None else term_rms[1:], on_ridge, adjusted, drive)
+                      None if term_rms is None else term_rms[1:], on_ridge, adjusted,
+                      drive if own_drive_N is None else own_drive_N)
