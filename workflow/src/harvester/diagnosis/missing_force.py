@@ -17,7 +17,8 @@ from harvester.diagnosis.latent import LatentForce, latent_force
 from harvester.diagnosis.latent_views import Binned, EffectForce, effect_force, views
 from harvester.diagnosis.lines import ResidualLine, residual_line
 from harvester.diagnosis.relevance import (EffectSize, RelevanceFloor, drive_rms, effect_size,
-                                           response_change, ridge, term_force_rms)
+                                           own_span, response_change, ridge,
+                                           term_force_rms)
 from harvester.diagnosis.shapes import ShapeDescription, describe
 from harvester.model.structures import ModelStructure
 
@@ -77,9 +78,9 @@ def missing_force(state: BaselineState, window: tuple[int, int] | None = None,
     lf = latent_force(state, window, units=units, **latent_kwargs)
     desc = describe(lf)
     out = MissingForce(lf, desc, views(lf), residual_line=residual_line(lf))
-    # the drive over the named terms' own forces' span (term_force_rms), for their share
-    span_drive = None if record_input is None else \
-        drive_rms(lf, np.asarray(record_input)[state.problem.window[0]:])
+    # the drive over the named terms' own forces' span, for their share of it
+    u, start = own_span(state.problem, record_input)
+    span_drive = drive_rms(lf, u[start:])
     for effect in named:
         ef = effect_force(lf, effect.structure, effect.theta, state.problem.known, effect.term)
         response = None

@@ -187,15 +187,22 @@ def ridge(improved: ModelStructure, samples: np.ndarray, term_name: str
     return best if best is not None and abs(best[1]) > RIDGE_CORRELATION else None
 
 
+def own_span(problem, record_input: np.ndarray | None = None) -> tuple[np.ndarray, int]:
+    """(the input, the first sample) of the span a named term's own force is read over: the
+    input ``record_input`` (the whole record's; default ``problem``'s, which the diagnosis
+    cuts after its analysed window), simulated from its start and read from the start of
+    ``problem``'s window to its end: the lead-in left out, the held-out tail kept, the span a
+    generator's truth is stated over."""
+    u = problem.input if record_input is None else np.asarray(record_input, dtype=float)
+    return u, int(problem.window[0])
+
+
 def term_force_rms(problem, improved: ModelStructure, samples: np.ndarray, term_name: str,
                    draws: int = TERM_DRAWS, record_input: np.ndarray | None = None
                    ) -> tuple[float, float, float]:
     """The median, 2.5 % and 97.5 % points of the RMS (N) of ``term_name``'s own force over
     ``draws`` posterior ``samples`` of ``improved`` (rows: free parameters, sigma last
-    optional; evenly thinned), each along its own simulated response to ``record_input``
-    (the whole record's input; default ``problem``'s, which the diagnosis cuts after its
-    analysed window) from the start of ``problem``'s window to the record's end: the
-    lead-in left out, the held-out tail kept, the span a generator's truth is stated over.
+    optional; evenly thinned), each along its own simulated response over :func:`own_span`.
     Under a slow envelope the span matters: on three rotor-inertia records of the literature
     generator the truth's RMS over 1-29.9 s and over 1-40 s differed by -7.7 % to +6.2 %.
     Its own path, not the smoother's: a sign law along a path uncertain by a few mm/s never
@@ -204,9 +211,8 @@ def term_force_rms(problem, improved: ModelStructure, samples: np.ndarray, term_
     other = dataclasses.replace(problem, structure=improved)
     rows = np.asarray(samples, dtype=float)
     rows = rows[np.unique(np.linspace(0, len(rows) - 1, min(draws, len(rows))).astype(int))]
-    u = problem.input if record_input is None else np.asarray(record_input, dtype=float)
+    u, start = own_span(problem, record_input)
     sim = other.simulate(rows, u)
-    start = problem.window[0]
     yb = u if problem.input_kind == "base_acc" else np.zeros_like(u)
     t, rms = term(term_name), []
     for i in np.flatnonzero(sim.ok):
