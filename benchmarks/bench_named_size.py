@@ -9,7 +9,9 @@ recorded input (``harvester.synthetic.literature.generate``). Each is diagnosed 
 per record: effect, seed, noise, verdict, the first named term, its parameters beside the
 truth's (a mass error's dM and m_share; their distance in posterior sds), its own force's RMS
 with its 95 % interval, the generator's missing force RMS, whether the interval holds it
-(``grid.scoring.named_size``; for a tie, its first member's), and the wall time. A record or diagnosis.json already in
+(``grid.scoring.named_size``; for a tie, its first member's), which part both are of (the
+whole force, or its varying part where the diagnosis says the record leaves the mean to the
+term's form), and the wall time. A record or diagnosis.json already in
 ``--out`` is reused (the record is checked against a new one first).
 
     python benchmarks/bench_named_size.py [--effects payload_error rotor_inertia_error]
@@ -99,7 +101,7 @@ def row(effect: str, seed: int, shared: bool, truth: dict, diag: dict, seconds: 
     return (f"{effect:20s} {seed:3d} {'shared' if shared else 'own':6s} "
             f"{diag['verdict']:16s} {names:28s} {params:60s} "
             f"{size['size_N']:9.4g} ({size['size_lo_N']:.4g}-{size['size_hi_N']:.4g}) "
-            f"{size['size_true_N']:9.4g} {covered:4s} {seconds:6.0f}")
+            f"{size['size_true_N']:9.4g} {covered:4s} {size['size_part']:7s} {seconds:6.0f}")
 
 
 def main() -> None:
@@ -116,7 +118,7 @@ def main() -> None:
     out.mkdir(parents=True, exist_ok=True)
     print(f"# records and diagnoses in {out}")
     print("# effect seed noise verdict names parameters (truth, distance) "
-          "own force N (95 %) truth covered wall_s")
+          "own force N (95 %) truth covered part wall_s")
     for seed in args.seeds:
         for effect in args.effects:
             for noise in args.noise:

@@ -258,6 +258,25 @@ def test_a_named_terms_size_is_checked_against_the_generators_missing_force():
     assert row["size_covered"] == 0.0 and row["size_lo_N"] == 0.35 and row["size_N"] == 0.4
     assert np.isnan(det.named_size(truth, _diag())["size_covered"])
     assert np.isnan(det.named_size(_truth("duffing", 0.5, 0), sized)["size_covered"])
+    # where the diagnosis leaves the mean to the term's form, the varying parts are compared
+    even = {**_diag("asymmetric_friction"), "missing_force": {"named_effects": [
+        {"term": "asymmetric_friction", "term_force_rms_N": 0.24,
+         "term_force_rms_interval_N": [0.23, 0.26], "term_force_mean_unfixed": True,
+         "term_force_varying_rms_N": 0.115, "term_force_varying_rms_interval_N": [0.11, 0.12]}]}}
+    asym = {"literature": {"missing_force_rms_N": 0.28, "missing_force_varying_rms_N": 0.118}}
+    got = det.named_size(asym, even)
+    assert got["size_covered"] == 1.0 and got["size_part"] == "varying"
+    assert got["size_true_N"] == 0.118 and got["size_N"] == 0.115
+    assert det.named_size(asym, {**even, "missing_force": {"named_effects": [
+        {**even["missing_force"]["named_effects"][0], "term_force_mean_unfixed": False}]}}
+    )["size_covered"] == 0.0
+    # several named, sized together from one fit: their summed force against the truth
+    two = {**_diag("cubic_stiffness", "inertia_error"), "missing_force": {
+        "named_effects": sized["missing_force"]["named_effects"],
+        "together": {"rms_N": 0.0049, "rms_interval_N": [0.0046, 0.0052],
+                     "mean_unfixed": False}}}
+    got = det.named_size({"literature": {"missing_force_rms_N": 0.00497}}, two)
+    assert got["size_covered"] == 1.0 and got["size_part"] == "whole together"
 
 
 def _informed(diagnosis, lam=0.1, window=(1.0, 16.0), rate=256.0, alpha=0.05):

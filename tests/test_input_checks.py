@@ -447,9 +447,10 @@ def test_reader_returns_the_warnings_and_the_sidecar(valid, tmp_path):
     assert "r.csv, line" in str(checked.warnings[0])
 
 
-def _two_accelerometers(seconds: float = 60.0, fs: float = 256.0, seed: int = 3):
+def _two_accelerometers(seconds: float = 60.0, fs: float = 256.0, seed: int = 3,
+                        rms: float = 2.0):
     """A linear device (M 10 kg, m 3 kg, f_n 1.5 Hz, 5 % damping) shaken over 0.3-5 Hz
-    (2 m/s^2 RMS), rel_acc formed as the mass's accelerometer minus the base's, each with
+    (``rms`` m/s^2), rel_acc formed as the mass's accelerometer minus the base's, each with
     0.05 m/s^2 of white noise: beyond 5 Hz the base channel holds its noise alone, and
     rel_acc holds the same noise with gain -1. Synthesised in the frequency domain (periodic,
     no start-up)."""
@@ -458,7 +459,7 @@ def _two_accelerometers(seconds: float = 60.0, fs: float = 256.0, seed: int = 3)
     f = np.fft.rfftfreq(n, 1.0 / fs)
     spec = np.where((f > 0.3) & (f < 5.0), np.exp(2j * np.pi * rng.uniform(size=f.size)), 0)
     y = np.fft.irfft(spec, n)
-    y *= 2.0 / np.std(y)
+    y *= rms / np.std(y)
     M, m, k = 10.0, 3.0, 10.0 * (2 * np.pi * 1.5) ** 2
     w = 2 * np.pi * f
     z = np.fft.irfft(np.fft.rfft(y) * m * w**2 / (k - M * w**2 + 2j * 0.05 * np.sqrt(k * M) * w),
@@ -469,11 +470,14 @@ def _two_accelerometers(seconds: float = 60.0, fs: float = 256.0, seed: int = 3)
     return df, {"M": M, "m": m, "k": k}
 
 
-def test_a_base_sensors_noise_shared_by_rel_acc_is_not_a_unit_slip():
+@pytest.mark.parametrize("rms", [2.0, 0.25])
+def test_a_base_sensors_noise_shared_by_rel_acc_is_not_a_unit_slip(rms):
     """Beyond the excitation's band the coherent FRF lines hold the base sensor's noise at
     gain 1, above the device's m/M = 0.3: the record is read with a warning that says so (it
-    was refused as a unit slip); a slip by g on the same record is still refused."""
-    df, known = _two_accelerometers()
+    was refused as a unit slip); a slip by g on the same record is still refused. At 0.25
+    m/s^2 the noise's lines reach 1.5e-3 of the excitation's strongest (the literature
+    grid's effect-free seed 36: 1.4e-3), which a rule of 1e-3 of that line missed."""
+    df, known = _two_accelerometers(rms=rms)
     kinds = RecordingKinds("base_acc", "rel_acc")
     g = checks.gain_above_resonance(df, kinds, 1 / 256.0, known)
     assert g["ratio"] > checks.UNIT_RATIO and g["ratio_ceiling"] < checks.UNIT_RATIO

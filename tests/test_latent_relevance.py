@@ -102,11 +102,11 @@ def test_one_named_effect_is_sized_by_its_own_force_in_the_headline():
     together keep the force beyond the baseline's."""
     from types import SimpleNamespace
 
-    from harvester.diagnosis.relevance import EffectSize, RelevanceFloor
+    from harvester.diagnosis.relevance import EffectSize, OwnForce, RelevanceFloor
     from harvester.diagnosis.verdict import _named
+    own = OwnForce((0.189, 0.128, 0.202), (0.001, -0.01, 0.01), (0.189, 0.128, 0.202), False)
     size = EffectSize("end_stop", 9.97, 3.71, 0.0, None, None, False, RelevanceFloor(),
-                      term_rms_N=0.189, term_rms_interval_N=(0.128, 0.202),
-                      drive_rms_N=9.97 / 3.71)
+                      own=own, drive_rms_N=9.97 / 3.71)
     found = SimpleNamespace(named_fit=None, improved_fit=None, missing=["end_stop"], ties=[])
     said = _named(found, SimpleNamespace(sizes=[size]))
     assert said == ("end_stop (its own force 0.189 N RMS, 95 % 0.128-0.202, 7.03% of the "
@@ -115,6 +115,19 @@ def test_one_named_effect_is_sized_by_its_own_force_in_the_headline():
                                  missing=["end_stop", "cubic_stiffness"], ties=[]),
                  SimpleNamespace(sizes=[size, size]))
     assert "(together 9.97 N RMS, 371.00% of the drive, relevant)" in two
+    # sized together from one fit: their own forces summed, with the interval
+    both = OwnForce((0.00493, 0.0046, 0.0052), (0.0, -1e-4, 1e-4), (0.00493, 0.0046, 0.0052),
+                    False)
+    two = _named(SimpleNamespace(named_fit=None, improved_fit=None,
+                                 missing=["end_stop", "cubic_stiffness"], ties=[]),
+                 SimpleNamespace(sizes=[size, size], together=both))
+    assert two.endswith("(together their own force 0.00493 N RMS, 95 % 0.0046-0.0052, "
+                        "0.18% of the drive, relevant)")
+    # an even force on an acceleration record: its varying part, its mean said apart
+    size.own = OwnForce((0.24, 0.23, 0.26), (0.21, 0.2, 0.22), (0.115, 0.11, 0.12), False)
+    assert _named(found, SimpleNamespace(sizes=[size])) == (
+        "end_stop (its own force 0.115 N RMS about its mean, 95 % 0.11-0.12, its mean 0.21 N "
+        "the form's, not the record's, 4.28% of the drive, relevant)")
 
 
 def test_an_own_forces_share_of_the_drive_is_over_its_own_span():
@@ -123,7 +136,8 @@ def test_an_own_forces_share_of_the_drive_is_over_its_own_span():
     record after the lead-in), while the force along the states keeps the window's."""
     from types import SimpleNamespace
 
-    from harvester.diagnosis.relevance import EffectSize, RelevanceFloor, drive_rms, effect_size
+    from harvester.diagnosis.relevance import (EffectSize, OwnForce, RelevanceFloor, drive_rms,
+                                               effect_size)
     window = np.full(100, 2.0)
     from harvester.data.units import SI
     lf = SimpleNamespace(values={"m": 0.5}, input_kind="base_acc", input=window, units=SI)
@@ -131,7 +145,8 @@ def test_an_own_forces_share_of_the_drive_is_over_its_own_span():
     assert drive_rms(lf, np.full(50, 4.0)) == pytest.approx(2.0)
     ef = SimpleNamespace(term="inertia_error", rms_N=0.1, share=0.2)
     for own, drive in ((None, 1.0), (2.0, 2.0)):
-        size = effect_size(lf, ef, RelevanceFloor(), term_rms=(0.3, 0.25, 0.35),
+        size = effect_size(lf, ef, RelevanceFloor(),
+                           own=OwnForce((0.3, 0.25, 0.35), (0.0, -0.01, 0.01), (0.3, 0.25, 0.35)),
                            own_drive_N=own)
         assert isinstance(size, EffectSize) and size.share_of_drive == pytest.approx(0.1)
         assert size.own_share_of_drive == pytest.approx(0.3 / drive)

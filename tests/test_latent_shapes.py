@@ -290,8 +290,10 @@ def test_a_named_terms_own_force_is_sized_with_its_interval():
     improved = structure("linear+coulomb_friction")
     for level, holds in ((6.0, True), (4.0, False)):
         samples = np.column_stack([np.full(200, 60.0), rng.normal(level, 0.15, 200)])
-        mid, lo, hi = term_force_rms(state.problem, improved, samples, "coulomb_friction")
+        own = term_force_rms(state.problem, improved, samples, "coulomb_friction")
+        mid, lo, hi = own.rms
         assert lo < mid < hi and (lo <= rms_true <= hi) == holds, (lo, rms_true, hi)
+        assert not own.mean_unfixed  # an odd law has no mean to speak of
     assert parameter_values(improved, samples[0], {"M": 1.0})["F_coulomb"] == samples[0, 1]
     # the diagnosis's problem stops 0.5 s after its analysed window: given the whole
     # record's input, the span is the record's, as if the problem had held it all
@@ -304,7 +306,58 @@ def test_a_named_terms_own_force_is_sized_with_its_interval():
     again = term_force_rms(cut, improved, samples, "coulomb_friction",
                            record_input=state.problem.input)
     shorter = term_force_rms(cut, improved, samples, "coulomb_friction")
-    assert again == pytest.approx(full, rel=1e-9) and shorter != pytest.approx(full, rel=1e-6)
+    assert again.rms == pytest.approx(full.rms, rel=1e-9)
+    assert shorter.rms != pytest.approx(full.rms, rel=1e-6)
+
+
+def test_several_named_terms_are_sized_together_from_the_fit_that_holds_them():
+    """missing_force.together_force: a Coulomb law and a cubic spring at k_cubic = 0 named
+    from one fit: their summed own force is the Coulomb law's alone; from two fits, or one
+    term, nothing."""
+    from harvester.diagnosis.missing_force import NamedEffect, together_force
+    from harvester.diagnosis.relevance import term_force_rms
+    from harvester.model.structures import structure
+    truth = rk4_record(lambda z, v, t: 6.0 * np.tanh(v / 1e-3), 8.0)
+    state = linear_state(recording(truth, "rel_acc"))
+    both = structure("linear+coulomb_friction+cubic_stiffness")
+    rows = np.column_stack([np.full(40, 60.0), np.random.default_rng(2).normal(6.0, 0.1, 40),
+                            np.zeros(40)])
+    named = [NamedEffect(t, both, rows[0], rows, both) for t in ("coulomb_friction",
+                                                                  "cubic_stiffness")]
+    alone = term_force_rms(state.problem, both, rows, "coulomb_friction")
+    assert together_force(state.problem, named).rms == pytest.approx(alone.rms, rel=1e-12)
+    apart = [named[0], dataclasses.replace(named[1], samples=rows.copy())]
+    assert together_force(state.problem, apart) is None
+    assert together_force(state.problem, named[:1]) is None
+
+
+def test_an_even_terms_mean_is_said_apart_on_an_acceleration_record():
+    """relevance.OwnForce: direction-dependent friction F tanh(v / v_a)^2 (even in v, most of
+    its mean square a mean) at its true parameters gives the truth's RMS, mean and RMS about
+    the mean along the true path; from z'' the mean is the term's form's (a constant force
+    only moves the rest position), from z it is seen. The size sentence then gives the
+    varying part first, and the headline reads it."""
+    from harvester.diagnosis.relevance import EffectSize, RelevanceFloor, term_force_rms
+    from harvester.model.structures import structure
+    truth = rk4_record(lambda z, v, t: 0.8 * np.tanh(v / 0.02) ** 2, 12.0)
+    improved = structure("linear+asymmetric_friction")
+    samples = np.tile([60.0, 0.8, 0.02], (40, 1))
+    f = truth["f"][int(FS):]  # linear_state's lead-in of 1 s
+    for output, unfixed in (("rel_acc", True), ("rel_disp", False)):
+        state = linear_state(recording(truth, output))
+        own = term_force_rms(state.problem, improved, samples, "asymmetric_friction")
+        assert own.rms[0] == pytest.approx(np.sqrt(np.mean(f**2)), rel=0.02)
+        assert own.mean[0] == pytest.approx(np.mean(f), rel=0.02)
+        assert own.varying[0] == pytest.approx(np.std(f), rel=0.02)
+        assert own.mean_unfixed == unfixed
+    size = EffectSize("asymmetric_friction", 0.3, 0.1, 0.9, None, None, False,
+                      RelevanceFloor(), own=own, drive_rms_N=10.0)
+    assert "about its mean" not in size.sentence()
+    size.own = dataclasses.replace(own, mean_seen=False)
+    text = size.sentence()
+    assert f"{own.varying[0]:.3g} N RMS about its mean" in text and "form's" in text
+    assert size.own_share_of_drive == pytest.approx(own.varying[0] / 10.0)
+    assert size.to_dict()["term_force_mean_unfixed"] is True
 
 
 def test_a_term_whose_strength_trades_against_the_baseline_is_said_on_a_ridge():

@@ -486,24 +486,29 @@ def test_a_cogging_record_is_described_periodic_in_z_with_its_period(tmp_path):
 
 
 def test_the_missing_force_is_the_effects_own_force_along_the_true_path():
-    """missing_force_rms: zero for the device alone (the equation of motion closes to
-    rounding); a spring even in z added to it: the RMS of that spring's own force along the
-    path the record was made of; a mass error: dM z'' + dm y''."""
+    """missing_force_truth: zero for the device alone (the equation of motion closes to
+    rounding); a spring even in z added to it: the RMS, mean and RMS about the mean of that
+    spring's own force along the path the record was made of; a mass error: dM z'' + dm y''."""
     from types import SimpleNamespace
     tb, run, ctx = _setup(4.0)
     window = L._internal_window(tb)
     none = SimpleNamespace(kind=L.NONE, p=DEVICE.params(), n_sub=2, context=ctx)
-    assert L.missing_force_rms(run, none) < 1e-9 * DEVICE.m * DEVICE.peak_base_acc
+    assert L.missing_force_truth(run, none)["missing_force_rms_N"] < (
+        1e-9 * DEVICE.m * DEVICE.peak_base_acc)
     _, _, (kind, p) = _shape_and_effect("quadratic_spring", 0.2)
     _, _, z, v = run.output(kind, p, 2, internal=True)
     own = np.array([L._extra_force(kind, p, a, b, 0.0) for a, b in zip(z, v)])[window]
-    spring = SimpleNamespace(kind=kind, p=p, n_sub=2, context=ctx)
-    assert L.missing_force_rms(run, spring) == pytest.approx(np.sqrt(np.mean(own**2)), rel=1e-9)
+    spring = L.missing_force_truth(run, SimpleNamespace(kind=kind, p=p, n_sub=2, context=ctx))
+    assert spring["missing_force_rms_N"] == pytest.approx(np.sqrt(np.mean(own**2)), rel=1e-9)
+    assert spring["missing_force_mean_N"] == pytest.approx(np.mean(own), rel=1e-9)
+    assert spring["missing_force_varying_rms_N"] == pytest.approx(np.std(own), rel=1e-9)
+    assert abs(spring["missing_force_mean_N"]) > 0.1 * spring["missing_force_rms_N"]  # even
     heavier = DEVICE.params(M=DEVICE.M + 0.3, m=DEVICE.m + 0.2)
     _, acc, _, _ = run.output(L.NONE, heavier, 2, internal=True)
     own = (0.3 * acc + 0.2 * run.base_internal())[window]
     mass = SimpleNamespace(kind=L.NONE, p=heavier, n_sub=2, context=ctx)
-    assert L.missing_force_rms(run, mass) == pytest.approx(np.sqrt(np.mean(own**2)), rel=1e-9)
+    assert L.missing_force_truth(run, mass)["missing_force_rms_N"] == pytest.approx(
+        np.sqrt(np.mean(own**2)), rel=1e-9)
 
 
 def test_the_input_noise_can_be_the_recordings_own():

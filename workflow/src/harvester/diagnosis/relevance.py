@@ -18,7 +18,9 @@ Sizes, along the latent force's smoothed states (``latent_views.effect_force``):
 The named term's own force X_T (``term_force``: what its law exerts, beside the re-fitted
 baseline's share of dF) is the physical size a generator's truth is compared with: its RMS
 over TERM_DRAWS posterior samples, each along its own simulated response to the recorded
-input (``term_force_rms``): its median and 95 % interval.
+input (``term_force_rms``): its median and 95 % interval; on an acceleration record, where
+a mean is much of it, its RMS about the mean, the mean being the term's form's
+(``OwnForce.mean_unfixed``).
 
 Floor (``RelevanceFloor``, on by default): an effect is negligible when its force lies below
 0.5 % of the drive and its response change below 1 % of the output. The false alarm of the
@@ -33,6 +35,7 @@ power-law spring "adequate"); the force can.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -58,6 +61,56 @@ class RelevanceFloor:
         return dataclasses.asdict(self)
 
 
+#: Share of a named term's own force's mean square held by its mean above which, on an
+#: acceleration record, its size is said apart from its mean (:attr:`OwnForce.mean_unfixed`).
+#: Odd laws hold next to none of it as a mean (0.02 % or less for the cubic spring, the
+#: quadratic damper, the Stribeck law and a mass error on literature records), an even one
+#: most of it (direction-dependent friction: 77 % and 84 % on two).
+MEAN_SHARE = 0.05
+
+
+@dataclass(frozen=True)
+class OwnForce:
+    """A named term's own force over its posterior (:func:`term_force_rms`), N: the median
+    and 95 % interval of its RMS, of its mean and of its RMS about the mean (its varying
+    part); ``mean_seen``: whether the record's output sees a constant force."""
+
+    rms: tuple[float, float, float]
+    mean: tuple[float, float, float]
+    varying: tuple[float, float, float]
+    mean_seen: bool = True
+
+    @property
+    def mean_unfixed(self) -> bool:
+        """Whether the record leaves its mean to the term's form: a constant force only
+        moves the rest position, which an acceleration (rel_acc) does not see, so where the
+        mean is a share of the mean square beyond MEAN_SHARE its RMS is the form's guess and
+        the varying part is what the record fixes. On two literature records of
+        direction-dependent friction F_c S(v/v_t)(1 + s tanh(v/v_a)) (two transitions, the
+        library term's tanh(v/v_asym)^2 one) the term's varying part was the truth's to 3 %
+        and its mean 14-15 % short, its RMS 12-13 % (docs/measurements.md)."""
+        return (not self.mean_seen) and self.mean[0] ** 2 > MEAN_SHARE * self.rms[0] ** 2
+
+    @property
+    def fixed(self) -> tuple[float, float, float]:
+        """The size the record fixes: the varying part where the mean is the form's
+        (:attr:`mean_unfixed`), else the RMS."""
+        return self.varying if self.mean_unfixed else self.rms
+
+    def to_dict(self) -> dict:
+        """Medians and intervals (N), and whether the mean is the form's."""
+        return {"rms_N": self.rms[0], "rms_interval_N": list(self.rms[1:]),
+                "mean_N": self.mean[0], "mean_interval_N": list(self.mean[1:]),
+                "varying_rms_N": self.varying[0],
+                "varying_rms_interval_N": list(self.varying[1:]),
+                "mean_unfixed": self.mean_unfixed}
+
+
+def _median_interval(x: list[float]) -> tuple[float, float, float]:
+    mid, lo, hi = np.percentile(x, [50.0, 2.5, 97.5])
+    return float(mid), float(lo), float(hi)
+
+
 @dataclass
 class EffectSize:
     """A named effect's physical size and relevance (module docstring)."""
@@ -72,9 +125,8 @@ class EffectSize:
     floor: RelevanceFloor
     units: Units = SI  # the recording's (force_rms_N is in its force unit)
     share_of_missing: float | None = None
-    #: RMS of the named term's own force X_T: median and 95 % interval over the posterior
-    term_rms_N: float | None = None
-    term_rms_interval_N: tuple[float, float] | None = None
+    #: the named term's own force X_T over the posterior (:func:`term_force_rms`)
+    own: OwnForce | None = None
     #: (baseline parameter, posterior correlation) where the term's strength lies on a ridge
     ridge: tuple[str, float] | None = None
     #: whether the interval's posterior was adjusted for correlated residuals
@@ -93,21 +145,46 @@ class EffectSize:
         return "detectable but negligible" if self.negligible else "relevant"
 
     @property
-    def own_share_of_drive(self) -> float | None:
-        """The term's own force (median RMS) over the drive's RMS, None without either."""
-        if self.term_rms_N is None or not self.drive_rms_N:
+    def term_rms_N(self) -> float | None:
+        """The median RMS of the term's own force, None without it."""
+        return None if self.own is None else self.own.rms[0]
+
+    @property
+    def term_rms_interval_N(self) -> tuple[float, float] | None:
+        """The 95 % interval of the term's own force's RMS, None without it."""
+        return None if self.own is None else self.own.rms[1:]
+
+    def own_sentence(self) -> str | None:
+        """The term's own force with its 95 % interval (its varying part apart from its mean
+        where the record leaves the mean to the term's form, :attr:`OwnForce.mean_unfixed`),
+        None without it."""
+        if self.own is None:
             return None
-        return self.term_rms_N / self.drive_rms_N
+        unit, how = self.units.label("force"), (", adjusted for correlated residuals"
+                                                if self.interval_adjusted else "")
+        (mid, lo, hi), (vmid, vlo, vhi) = self.own.rms, self.own.varying
+        text = f"its own force {mid:.3g} {unit} RMS (95 %{how}: {lo:.3g}-{hi:.3g})"
+        if not self.own.mean_unfixed:
+            return text
+        return (f"its own force {vmid:.3g} {unit} RMS about its mean (95 %{how}: "
+                f"{vlo:.3g}-{vhi:.3g}; its mean, {self.own.mean[0]:.3g} {unit}, {mid:.3g} "
+                "RMS with it, is the term's form's, not the record's: a constant force only "
+                "moves the rest position, which an acceleration does not see)")
+
+    @property
+    def own_share_of_drive(self) -> float | None:
+        """The term's own force (median RMS; about its mean where the record leaves the mean
+        to the term's form) over the drive's RMS, None without either."""
+        if self.own is None or not self.drive_rms_N:
+            return None
+        return self.own.fixed[0] / self.drive_rms_N
 
     def sentence(self) -> str:
         text = (f"{self.term}: {self.force_rms_N:.3g} {self.units.label('force')} RMS "
                 f"({100 * self.share_of_drive:.2g} % of the drive), explains "
                 f"{100 * max(self.explains, 0):.0f} % of the missing force")
-        if self.term_rms_interval_N is not None:
-            lo, hi = self.term_rms_interval_N
-            how = ", adjusted for correlated residuals" if self.interval_adjusted else ""
-            text += (f"; the term's own force {self.term_rms_N:.3g} {self.units.label('force')}"
-                     f" RMS (95 %{how}: {lo:.3g}-{hi:.3g})")
+        if self.own is not None:
+            text += f"; {self.own_sentence()}"
         if self.ridge is not None:
             text += (f", on a ridge with {self.ridge[0]} (posterior correlation "
                      f"{self.ridge[1]:.2f}): the record fixes their combination, not the "
@@ -117,14 +194,19 @@ class EffectSize:
                      " % RMS on unseen data")
         return f"{text}: {self.label}"
 
+    def _own_parts(self) -> dict:
+        """The own force (``OwnForce.to_dict``, each key prefixed term_force_) for
+        diagnosis.json; its RMS and interval None without it."""
+        if self.own is None:
+            return {"term_force_rms_N": None, "term_force_rms_interval_N": None}
+        return {f"term_force_{k}": v for k, v in self.own.to_dict().items()}
+
     def to_dict(self) -> dict:
         return {"term": self.term, "force_rms_N": self.force_rms_N,
                 "force_unit": self.units.label("force"),
                 "share_of_drive": self.share_of_drive, "share_of_latent": self.share_of_latent,
                 "share_of_missing": self.share_of_missing,
-                "term_force_rms_N": self.term_rms_N,
-                "term_force_rms_interval_N": (None if self.term_rms_interval_N is None
-                                              else list(self.term_rms_interval_N)),
+                **self._own_parts(),
                 "ridge": None if self.ridge is None else {"parameter": self.ridge[0],
                                                           "correlation": self.ridge[1]},
                 "interval_adjusted": self.interval_adjusted,
@@ -197,12 +279,13 @@ def own_span(problem, record_input: np.ndarray | None = None) -> tuple[np.ndarra
     return u, int(problem.window[0])
 
 
-def term_force_rms(problem, improved: ModelStructure, samples: np.ndarray, term_name: str,
-                   draws: int = TERM_DRAWS, record_input: np.ndarray | None = None
-                   ) -> tuple[float, float, float]:
-    """The median, 2.5 % and 97.5 % points of the RMS (N) of ``term_name``'s own force over
-    ``draws`` posterior ``samples`` of ``improved`` (rows: free parameters, sigma last
-    optional; evenly thinned), each along its own simulated response over :func:`own_span`.
+def term_force_rms(problem, improved: ModelStructure, samples: np.ndarray,
+                   term_name: str | Sequence[str], draws: int = TERM_DRAWS,
+                   record_input: np.ndarray | None = None) -> OwnForce:
+    """``term_name``'s own force (several terms': their sum) over ``draws`` posterior
+    ``samples`` of ``improved`` (rows:
+    free parameters, sigma last optional; evenly thinned), each along its own simulated
+    response over :func:`own_span`: its RMS, mean and varying part (:class:`OwnForce`).
     Under a slow envelope the span matters: on three rotor-inertia records of the literature
     generator the truth's RMS over 1-29.9 s and over 1-40 s differed by -7.7 % to +6.2 %.
     Its own path, not the smoother's: a sign law along a path uncertain by a few mm/s never
@@ -214,28 +297,30 @@ def term_force_rms(problem, improved: ModelStructure, samples: np.ndarray, term_
     u, start = own_span(problem, record_input)
     sim = other.simulate(rows, u)
     yb = u if problem.input_kind == "base_acc" else np.zeros_like(u)
-    t, rms = term(term_name), []
+    terms = [term(n) for n in ([term_name] if isinstance(term_name, str) else term_name)]
+    forces = []
     for i in np.flatnonzero(sim.ok):
         values = parameter_values(improved, rows[i, :len(improved.free_parameters)],
                                   problem.known)
-        f = term_force(t, values, sim.rel_disp[i], sim.rel_vel[i], sim.rel_acc[i], yb,
-                       problem.dt)[0, start:]
-        rms.append(float(np.sqrt(np.mean(f**2))))
-    if not rms:
+        forces.append(sum(term_force(t, values, sim.rel_disp[i], sim.rel_vel[i],
+                                     sim.rel_acc[i], yb, problem.dt)[0, start:]
+                          for t in terms))
+    if not forces:
         raise RuntimeError(f"{improved.name} cannot be simulated at its posterior samples")
-    mid, lo, hi = np.percentile(rms, [50.0, 2.5, 97.5])
-    return float(mid), float(lo), float(hi)
-
+    return OwnForce(_median_interval([float(np.sqrt(np.mean(f**2))) for f in forces]),
+                    _median_interval([float(np.mean(f)) for f in forces]),
+                    _median_interval([float(np.std(f)) for f in forces]),
+                    mean_seen=problem.output_kind == "rel_disp")
 
 def effect_size(lf: LatentForce, ef: EffectForce, floor: RelevanceFloor = RelevanceFloor(),
                 response: tuple[float, float] | None = None,
                 share_of_missing: float | None = None,
-                term_rms: tuple[float, float, float] | None = None,
+                own: OwnForce | None = None,
                 on_ridge: tuple[str, float] | None = None,
                 adjusted: bool = False, own_drive_N: float | None = None) -> EffectSize:
     """The named effect's size from its force beside the latent force (``ef``) and, if
     given, its ``response`` change on unseen data (:func:`response_change`), its share as
-    the shapes read theirs, its own force's RMS (:func:`term_force_rms`) and the ridge its
+    the shapes read theirs, its own force (:func:`term_force_rms`) and the ridge its
     strength lies on (:func:`ridge`), and whether that interval's posterior was adjusted for
     correlated residuals (``adjusted``); labelled in ``lf.units``. ``own_drive_N``: the
     drive's RMS over the own force's span (default: over the window, as the shares)."""
@@ -246,6 +331,5 @@ def effect_size(lf: LatentForce, ef: EffectForce, floor: RelevanceFloor = Releva
     return EffectSize(ef.term, ef.rms_N, share, ef.share,
                       None if response is None else response[0],
                       None if response is None else response[1], negligible, floor, lf.units,
-                      share_of_missing, None if term_rms is None else term_rms[0],
-                      None if term_rms is None else term_rms[1:], on_ridge, adjusted,
+                      share_of_missing, own, on_ridge, adjusted,
                       drive if own_drive_N is None else own_drive_N)

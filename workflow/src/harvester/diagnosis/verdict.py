@@ -342,7 +342,10 @@ def _level(effect: str, fit: ModelFit | None, units: Units = SI) -> str:
 def _named(found: Conclusion, missing: MissingForce | None, units: Units = SI) -> str:
     """The effects named and tied, with their size where the missing force gave it. One
     effect's size is its term's own force along its own simulated response, with its 95 %
-    interval (``relevance.term_force_rms``); several effects' (or one without that) is the
+    interval (``relevance.term_force_rms``; about its mean where the record leaves the mean
+    to the term's form, ``relevance.OwnForce.mean_unfixed``); several effects' sized from one
+    fit, their own forces summed with their interval (``missing_force.together_force``);
+    several effects' (or one without that) is the
     improved model's force beyond the baseline's along the smoothed states
     (``latent_views.effect_force``), theirs together, said once. Along states uncertain by
     millimetres an impact term's force is not its own: a named end stop read 9.97 N RMS
@@ -355,13 +358,28 @@ def _named(found: Conclusion, missing: MissingForce | None, units: Units = SI) -
     if not sizes:
         return ", ".join(groups)
     s, force = sizes[0], units.label("force")
-    if len(sizes) == 1 and s.own_share_of_drive is not None and s.term_rms_interval_N:
-        lo, hi = s.term_rms_interval_N
-        return (", ".join(groups) + f" (its own force {s.term_rms_N:.3g} {force} RMS, 95 % "
-                f"{lo:.3g}-{hi:.3g}, {s.own_share_of_drive:.2%} of the drive, {s.label})")
+    both = getattr(missing, "together", None)
+    if len(sizes) == 1 and s.own_share_of_drive is not None and s.own is not None:
+        return ", ".join(groups) + _own_said(s.own, force, s.drive_rms_N, s.label, "its")
+    if len(sizes) > 1 and both is not None and s.drive_rms_N:
+        label = next((x.label for x in sizes if not x.negligible), s.label)
+        return ", ".join(groups) + _own_said(both, force, s.drive_rms_N, label, "their")
     together = "together " if len(sizes) > 1 else ""
     return (", ".join(groups) + f" ({together}{s.force_rms_N:.3g} {force} "
             f"RMS, {s.share_of_drive:.2%} of the drive, {s.label})")
+
+
+def _own_said(own, force: str, drive: float, label: str, whose: str) -> str:
+    """" (its own force X N RMS, 95 % a-b, P % of the drive, label)": about the mean where
+    the record leaves the mean to the form (``relevance.OwnForce.fixed``); "together their"
+    for several terms' summed force."""
+    (mid, lo, hi), unfixed = own.fixed, own.mean_unfixed
+    what = f"RMS about {whose} mean" if unfixed else "RMS"
+    mean = (f", {whose} mean {own.mean[0]:.3g} {force} the form's, not the record's"
+            if unfixed else "")
+    lead = "together their" if whose == "their" else "its"
+    return (f" ({lead} own force {mid:.3g} {force} {what}, 95 % {lo:.3g}-{hi:.3g}{mean}, "
+            f"{mid / drive:.2%} of the drive, {label})")
 
 
 def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,

@@ -19,7 +19,9 @@ Size (``named_size``). Where the truth gives the force the nominal device misses
 true path (``missing_force_rms_N``, the literature generator's), the first term named alone
 is checked against it: the RMS of its own force over its posterior, each sample along its
 own simulated path (median and 95 % interval; ``diagnosis.relevance.term_force_rms``), and
-whether that interval holds the truth. The two are one quantity for an effect added to the
+whether that interval holds the truth; where the diagnosis says an acceleration record
+leaves the force's mean to the term's form, both about their means
+(``missing_force_varying_rms_N``). The two are one quantity for an effect added to the
 device (a stop, a spring, a damper, a mass error); for a friction law with memory the truth
 is the law's departure from the sliding one, which a term beside a refitted sliding law need
 not equal.
@@ -223,26 +225,35 @@ def score(truth: Mapping[str, Any], diagnosis: Mapping[str, Any],
     }
 
 
-def named_size(truth: Mapping[str, Any], diagnosis: Mapping[str, Any]) -> dict[str, float]:
-    """The first named term's own force RMS (N: median, 95 % interval) beside the truth's
-    missing force RMS, whether the interval holds it (1.0 / 0.0; NaN where either is not
-    given: nothing named alone, a diagnosis without sizes, a generator without the truth),
-    and the baseline parameter its strength lies on a ridge with ("" for none)."""
-    true = (truth.get("literature") or truth).get("missing_force_rms_N")
+def named_size(truth: Mapping[str, Any], diagnosis: Mapping[str, Any]) -> dict[str, Any]:
+    """The first named term's own force RMS (N: median, 95 % interval; several named terms'
+    summed force where the diagnosis gives it, ``together``) beside the truth's missing
+    force RMS, whether the interval holds it (1.0 / 0.0; NaN where either is not given:
+    nothing named, a diagnosis without sizes, a generator without the truth), and the
+    baseline parameter its strength lies on a ridge with ("" for none). Where the diagnosis
+    says the record leaves the force's mean to the form (``mean_unfixed``), both are the
+    RMS about the mean (``size_part`` "varying", else "whole")."""
+    lit = truth.get("literature") or truth
     missing = list(diagnosis.get("missing") or [])
-    sizes = {e.get("term"): e for e in
-             ((diagnosis.get("missing_force") or {}).get("named_effects") or [])}
+    mf = diagnosis.get("missing_force") or {}
+    sizes = {e.get("term"): e for e in mf.get("named_effects") or []}
     size = sizes.get(missing[0]) if missing else None
+    both = mf.get("together") if len(missing) > 1 else None
+    own = ({k.removeprefix("term_force_"): v for k, v in size.items()}
+           if both is None and size is not None else both)
+    varying = bool(own and own.get("mean_unfixed"))
+    key = "varying_rms" if varying else "rms"
+    true = lit.get(f"missing_force_{key}_N")
     nan = float("nan")
-    if size is None or size.get("term_force_rms_interval_N") is None:
-        return {"size_true_N": nan if true is None else float(true), "size_N": nan,
-                "size_lo_N": nan, "size_hi_N": nan, "size_covered": nan, "size_ridge": ""}
-    lo, hi = (float(x) for x in size["term_force_rms_interval_N"])
-    return {"size_true_N": nan if true is None else float(true),
-            "size_N": float(size["term_force_rms_N"]), "size_lo_N": lo, "size_hi_N": hi,
+    out = {"size_true_N": nan if true is None else float(true), "size_N": nan,
+           "size_lo_N": nan, "size_hi_N": nan, "size_covered": nan, "size_ridge": "",
+           "size_part": ("varying" if varying else "whole") + (" together" if both else "")}
+    if own is None or own.get(f"{key}_interval_N") is None:
+        return out
+    lo, hi = (float(x) for x in own[f"{key}_interval_N"])
+    return {**out, "size_N": float(own[f"{key}_N"]), "size_lo_N": lo, "size_hi_N": hi,
             "size_covered": nan if true is None else float(lo <= float(true) <= hi),
-            "size_ridge": (size.get("ridge") or {}).get("parameter", "")}
-
+            "size_ridge": ((size or {}).get("ridge") or {}).get("parameter", "")}
 
 def _tie_label(diagnosis: Mapping[str, Any]) -> str:
     """The first tie as "a | b", or "unnamed" when the diagnosis named nothing."""

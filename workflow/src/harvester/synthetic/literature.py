@@ -1436,25 +1436,28 @@ def generate(name: str, seed: int, ratio: float = 0.5, duration_s: float = 40.0,
     driven = recorded_input_contribution(run, cal, recording["base_acc"].to_numpy())
     truth["input_driven_to_clean_contribution"] = (
         _rms((driven - contribution)[tb.window]) / max(_rms(contribution[tb.window]), 1e-300))
-    truth["missing_force_rms_N"] = missing_force_rms(run, cal)
+    truth.update(missing_force_truth(run, cal))
     truth["shared_input_noise"] = bool(shared_input_noise)
     return GeneratedRecording(recording, sidecar, truth, contribution, cal.with_effect,
                               cal.baseline, driven)
 
 
-def missing_force_rms(run: _Run, cal: _Calibrated) -> float:
-    """RMS (N) after the lead-in of the force the nominal device misses along the true path:
-    f = -(M z'' + m y'' + c z' + k z + F_c S(z' / v_t)) with the sidecar's masses and the
-    device's c, k and sliding law, z'' the mass's (its accelerometer's, with a hum) at the
-    internal rate. For an effect added to the device (a stop, a spring, a damper) it is the
-    effect's own force; for a mass error, dM z'' + dm y''; for a friction law with memory,
-    the law's departure from the sliding one."""
+def missing_force_truth(run: _Run, cal: _Calibrated) -> dict[str, float]:
+    """RMS (N) after the lead-in of the force the nominal device misses along the true path
+    (``missing_force_rms_N``), its mean (``missing_force_mean_N``) and its RMS about the mean
+    (``missing_force_varying_rms_N``, what a record of accelerations fixes): f = -(M z'' +
+    m y'' + c z' + k z + F_c S(z' / v_t)) with the sidecar's masses and the device's c, k and
+    sliding law, z'' the mass's (its accelerometer's, with a hum) at the internal rate. For an
+    effect added to the device (a stop, a spring, a damper) it is the effect's own force; for
+    a mass error, dM z'' + dm y''; for a friction law with memory, the law's departure from
+    the sliding one."""
     _, acc, z, v = run.output(cal.kind, cal.p, cal.n_sub, internal=True)
     d = cal.context.device
     law = d.F_c * _smooth_sign(FRICTION_FORMS.index(d.friction_form), v / d.v_t)
     f = -(d.M * acc + d.m * run.base_internal() + d.c * v + d.k * z + law)
-    return _rms(f[_internal_window(run.tb)])
-
+    f = f[_internal_window(run.tb)]
+    return {"missing_force_rms_N": _rms(f), "missing_force_mean_N": float(np.mean(f)),
+            "missing_force_varying_rms_N": float(np.std(f))}
 
 def recorded_input_contribution(run: _Run, cal: _Calibrated, base_acc: np.ndarray
                                 ) -> np.ndarray:
