@@ -108,12 +108,12 @@ def test_one_named_effect_is_sized_by_its_own_force_in_the_headline():
     size = EffectSize("end_stop", 9.97, 3.71, 0.0, None, None, False, RelevanceFloor(),
                       own=own, drive_rms_N=9.97 / 3.71)
     found = SimpleNamespace(named_fit=None, improved_fit=None, missing=["end_stop"], ties=[])
-    said = _named(found, SimpleNamespace(sizes=[size]))
+    said = _named(found, SimpleNamespace(sizes=[size], together=None))
     assert said == ("end_stop (its own force 0.189 N RMS, 95 % 0.128-0.202, 7.03% of the "
                     "drive, relevant)")
     two = _named(SimpleNamespace(named_fit=None, improved_fit=None,
                                  missing=["end_stop", "cubic_stiffness"], ties=[]),
-                 SimpleNamespace(sizes=[size, size]))
+                 SimpleNamespace(sizes=[size, size], together=None))
     assert "(together 9.97 N RMS, 371.00% of the drive, relevant)" in two
     # sized together from one fit: their own forces summed, with the interval
     both = OwnForce((0.00493, 0.0046, 0.0052), (0.0, -1e-4, 1e-4), (0.00493, 0.0046, 0.0052),
@@ -125,7 +125,7 @@ def test_one_named_effect_is_sized_by_its_own_force_in_the_headline():
                         "0.18% of the drive, relevant)")
     # an even force on an acceleration record: its varying part, its mean said apart
     size.own = OwnForce((0.24, 0.23, 0.26), (0.21, 0.2, 0.22), (0.115, 0.11, 0.12), False)
-    assert _named(found, SimpleNamespace(sizes=[size])) == (
+    assert _named(found, SimpleNamespace(sizes=[size], together=None)) == (
         "end_stop (its own force 0.115 N RMS about its mean, 95 % 0.11-0.12, its mean 0.21 N "
         "the form's, not the record's, 4.28% of the drive, relevant)")
 

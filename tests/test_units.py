@@ -119,11 +119,11 @@ def test_verdict_and_size_sentences_say_the_recordings_units() -> None:
     assert size.sentence().startswith("hysteresis: 0.2 V RMS (5 % of the drive)")
     assert size.to_dict()["force_unit"] == "V"
     found = SimpleNamespace(missing=["hysteresis"], ties=[], improved_fit=fit, named_fit=None)
-    named = _named(found, SimpleNamespace(sizes=[size]), VOLTS)
+    named = _named(found, SimpleNamespace(sizes=[size], together=None), VOLTS)
     assert named == ("hysteresis (friction, F_hyst 0.636 +- 0.0052 V) (0.2 V RMS, 5.00% of "
                      "the drive, relevant)") and " N" not in named
     si = EffectSize("hysteresis", 0.2, 0.05, 0.7, None, None, False, RelevanceFloor())
-    assert "(0.2 N RMS" in _named(found, SimpleNamespace(sizes=[si]))
+    assert "(0.2 N RMS" in _named(found, SimpleNamespace(sizes=[si], together=None))
 
 
 def test_units_reach_the_diagnosis_settings_and_the_prepared_sidecar() -> None:

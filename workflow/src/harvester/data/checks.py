@@ -68,6 +68,7 @@ import pandas as pd
 from scipy import signal
 
 from harvester.data.errors import DataError
+from harvester.data.input_noise import FLOOR_SPREAD, noise_floor
 from harvester.data.recording import G, RecordingKinds, check_plausible
 from harvester.data.units import SI, Units
 
@@ -380,7 +381,6 @@ def _on_input_floor(u: np.ndarray, f: np.ndarray, s_uu: np.ndarray, fs: float,
                     top: float) -> np.ndarray:
     """The lines whose input PSD ``s_uu`` lies on the input's white noise floor below
     ``top`` Hz (``input_noise.noise_floor``), none where it shows no floor."""
-    from harvester.data.input_noise import FLOOR_SPREAD, noise_floor
     floor = noise_floor(u, fs, top)
     if floor is None:
         return np.zeros(f.shape, dtype=bool)

@@ -30,6 +30,7 @@ from harvester.diagnosis.fits import ModelFit
 from harvester.diagnosis.detect import Detection
 from harvester.diagnosis.floor import Floor
 from harvester.diagnosis.missing_force import MissingForce
+from harvester.diagnosis.relevance import OwnForce
 from harvester.diagnosis.rounds import Round, rough_rivals
 from harvester.diagnosis.separate import Separation, separations
 from harvester.diagnosis.shapes import beyond_uncertainty, has_its_shape, library_terms
@@ -358,7 +359,7 @@ def _named(found: Conclusion, missing: MissingForce | None, units: Units = SI) -
     if not sizes:
         return ", ".join(groups)
     s, force = sizes[0], units.label("force")
-    both = getattr(missing, "together", None)
+    both = missing.together
     if len(sizes) == 1 and s.own_share_of_drive is not None and s.own is not None:
         return ", ".join(groups) + _own_said(s.own, force, s.drive_rms_N, s.label, "its")
     if len(sizes) > 1 and both is not None and s.drive_rms_N:
@@ -369,7 +370,7 @@ def _named(found: Conclusion, missing: MissingForce | None, units: Units = SI) -
             f"RMS, {s.share_of_drive:.2%} of the drive, {s.label})")
 
 
-def _own_said(own, force: str, drive: float, label: str, whose: str) -> str:
+def _own_said(own: OwnForce, force: str, drive: float, label: str, whose: str) -> str:
     """" (its own force X N RMS, 95 % a-b, P % of the drive, label)": about the mean where
     the record leaves the mean to the form (``relevance.OwnForce.fixed``); "together their"
     for several terms' summed force."""

@@ -21,7 +21,8 @@ is checked against it: the RMS of its own force over its posterior, each sample 
 own simulated path (median and 95 % interval; ``diagnosis.relevance.term_force_rms``), and
 whether that interval holds the truth; where the diagnosis says an acceleration record
 leaves the force's mean to the term's form, both about their means
-(``missing_force_varying_rms_N``). The two are one quantity for an effect added to the
+(``missing_force_varying_rms_N``); where several terms are named from one fit, their own
+forces summed (``diagnosis.missing_force.together_force``). The two are one quantity for an effect added to the
 device (a stop, a spring, a damper, a mass error); for a friction law with memory the truth
 is the law's departure from the sliding one, which a term beside a refitted sliding law need
 not equal.
@@ -254,6 +255,7 @@ def named_size(truth: Mapping[str, Any], diagnosis: Mapping[str, Any]) -> dict[s
     return {**out, "size_N": float(own[f"{key}_N"]), "size_lo_N": lo, "size_hi_N": hi,
             "size_covered": nan if true is None else float(lo <= float(true) <= hi),
             "size_ridge": ((size or {}).get("ridge") or {}).get("parameter", "")}
+
 
 def _tie_label(diagnosis: Mapping[str, Any]) -> str:
     """The first tie as "a | b", or "unnamed" when the diagnosis named nothing."""
