@@ -70,6 +70,18 @@ def test_withheld_names_are_said_beside_the_missing_force(tmp_path):
     assert "a friction drifting in time" in page and "no library effect named" not in page
 
 
+def test_names_sized_together_are_said_with_their_interval(tmp_path):
+    """Two names sized from one fit (``missing_force.together_force``): their summed own
+    force with its interval, in the recording's force unit."""
+    doc = {**DOC, "missing": ["cubic_stiffness", "inertia_error"], "missing_force": {
+        "named_effects": [{"term": "cubic_stiffness", "force_unit": "V", "sentence": "s"}],
+        "together": {"terms": ["cubic_stiffness", "inertia_error"], "rms_N": 0.00448,
+                     "rms_interval_N": [0.00407, 0.00492], "mean_unfixed": False}}}
+    page = summary_page(doc, tmp_path, "t")
+    assert ("together, cubic_stiffness + inertia_error: their own force 0.00448 V RMS "
+            "(95 % 0.00407-0.00492)") in page
+
+
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 
 

@@ -71,6 +71,8 @@ def _missing_lines(doc: Mapping[str, Any]) -> list[str]:
     lines = [f"<b>{_esc(e)}</b>: {_esc((cands.get(e) or {}).get('implies', ''))}"
              + (f"<br>size: {_esc(sizes[e]['sentence'])}" if e in sizes else "")
              for e in doc.get("missing") or []]
+    if mf.get("together"):
+        lines.append(_together_line(mf["together"], sizes))
     if doc.get("withheld"):
         lines.append("not named, their force lacks the missing force's shape: "
                      + ", ".join(_esc(e) for e in doc["withheld"]))
@@ -82,6 +84,17 @@ def _missing_lines(doc: Mapping[str, Any]) -> list[str]:
                      + (f"; the experiment that would: {_esc(tie['recommended'])}"
                         if tie.get("recommended") else ""))
     return lines or ["no library effect named"]
+
+
+def _together_line(both: Mapping[str, Any], sizes: Mapping[str, Any]) -> str:
+    """Several named terms' own forces summed, with the interval (about their mean where the
+    record leaves it to the form), in the recording's force unit."""
+    key = "varying_rms" if both.get("mean_unfixed") else "rms"
+    lo, hi = both[f"{key}_interval_N"]
+    unit = next((e.get("force_unit") for e in sizes.values() if e.get("force_unit")), "N")
+    about = " about their mean" if key == "varying_rms" else ""
+    return (f"together, {_esc(' + '.join(both.get('terms') or []))}: their own force "
+            f"{both[f'{key}_N']:.3g} {_esc(unit)} RMS{about} (95 % {lo:.3g}-{hi:.3g})")
 
 
 def _fit_rows(doc: Mapping[str, Any]) -> str:
