@@ -283,9 +283,9 @@ def term_force_rms(problem, improved: ModelStructure, samples: np.ndarray,
                    term_name: str | Sequence[str], draws: int = TERM_DRAWS,
                    record_input: np.ndarray | None = None) -> OwnForce:
     """``term_name``'s own force (several terms': their sum) over ``draws`` posterior
-    ``samples`` of ``improved`` (rows:
-    free parameters, sigma last optional; evenly thinned), each along its own simulated
-    response over :func:`own_span`: its RMS, mean and varying part (:class:`OwnForce`).
+    ``samples`` of ``improved`` (rows: free parameters, sigma last optional; evenly thinned),
+    each along its own simulated response over :func:`own_span`: its RMS, mean and varying
+    part (:class:`OwnForce`).
     Under a slow envelope the span matters: on three rotor-inertia records of the literature
     generator the truth's RMS over 1-29.9 s and over 1-40 s differed by -7.7 % to +6.2 %.
     Its own path, not the smoother's: a sign law along a path uncertain by a few mm/s never
@@ -311,6 +311,7 @@ def term_force_rms(problem, improved: ModelStructure, samples: np.ndarray,
                     _median_interval([float(np.mean(f)) for f in forces]),
                     _median_interval([float(np.std(f)) for f in forces]),
                     mean_seen=problem.output_kind == "rel_disp")
+
 
 def effect_size(lf: LatentForce, ef: EffectForce, floor: RelevanceFloor = RelevanceFloor(),
                 response: tuple[float, float] | None = None,

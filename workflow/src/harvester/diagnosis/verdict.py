@@ -360,27 +360,29 @@ def _named(found: Conclusion, missing: MissingForce | None, units: Units = SI) -
         return ", ".join(groups)
     s, force = sizes[0], units.label("force")
     both = missing.together
-    if len(sizes) == 1 and s.own_share_of_drive is not None and s.own is not None:
-        return ", ".join(groups) + _own_said(s.own, force, s.drive_rms_N, s.label, "its")
+    if len(sizes) == 1 and s.own_share_of_drive is not None:
+        return ", ".join(groups) + _own_said(s.own, force, s.own_share_of_drive, s.label,
+                                             "its")
     if len(sizes) > 1 and both is not None and s.drive_rms_N:
         label = next((x.label for x in sizes if not x.negligible), s.label)
-        return ", ".join(groups) + _own_said(both, force, s.drive_rms_N, label, "their")
+        return ", ".join(groups) + _own_said(both, force, both.fixed[0] / s.drive_rms_N,
+                                             label, "their")
     together = "together " if len(sizes) > 1 else ""
     return (", ".join(groups) + f" ({together}{s.force_rms_N:.3g} {force} "
             f"RMS, {s.share_of_drive:.2%} of the drive, {s.label})")
 
 
-def _own_said(own: OwnForce, force: str, drive: float, label: str, whose: str) -> str:
+def _own_said(own: OwnForce, force: str, share: float, label: str, whose: str) -> str:
     """" (its own force X N RMS, 95 % a-b, P % of the drive, label)": about the mean where
-    the record leaves the mean to the form (``relevance.OwnForce.fixed``); "together their"
-    for several terms' summed force."""
+    the record leaves the mean to the form (``relevance.OwnForce.fixed``), ``share`` of the
+    drive; "together their" for several terms' summed force."""
     (mid, lo, hi), unfixed = own.fixed, own.mean_unfixed
     what = f"RMS about {whose} mean" if unfixed else "RMS"
     mean = (f", {whose} mean {own.mean[0]:.3g} {force} the form's, not the record's"
             if unfixed else "")
     lead = "together their" if whose == "their" else "its"
     return (f" ({lead} own force {mid:.3g} {force} {what}, 95 % {lo:.3g}-{hi:.3g}{mean}, "
-            f"{mid / drive:.2%} of the drive, {label})")
+            f"{share:.2%} of the drive, {label})")
 
 
 def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
