@@ -96,6 +96,7 @@ def describe_only(csv: Path, truth: dict) -> tuple[dict, float]:
     from harvester.diagnosis.analysis import prepare, start_baseline
     from harvester.diagnosis.baseline import baseline_state
     from harvester.diagnosis.missing_force import missing_force
+    from harvester.diagnosis.run import fitted_shape
     from harvester.diagnosis.settings import DiagnosisSettings
     from harvester.initial.recording import diagnosis_priors
 
@@ -105,11 +106,13 @@ def describe_only(csv: Path, truth: dict) -> tuple[dict, float]:
     a = prepare(rec, None, "tanh", truth["known"], settings, str(csv))
     start = start_baseline(a, priors, None, settings)
     problem = a.chain(start.detection_problem, start.temper, structure=a.structure)
-    mf = missing_force(baseline_state(problem, start.samples), (a.lead, a.hold))
+    state = baseline_state(problem, start.samples)
+    mf = missing_force(state, (a.lead, a.hold))
+    mf.fitted_shape = fitted_shape(a, state, start, None, settings)
     with open(csv.with_suffix(".latent.pkl"), "wb") as fh:  # to refit the shapes offline
         pickle.dump(mf.latent, fh)
     return ({"verdict": "(not run)", "missing": [], "missing_force": mf.to_dict(),
-             "headline": mf.description.sentence}, time.perf_counter() - clock)
+             "headline": mf.sentence()}, time.perf_counter() - clock)
 
 
 def row(name: str, seed: int, truth: dict, diag: dict, seconds: float) -> str:
@@ -121,6 +124,11 @@ def row(name: str, seed: int, truth: dict, diag: dict, seconds: float) -> str:
     stands_out = not shape.get("sentence", "").startswith("no missing force")
     described = next((s for s in shapes if s["shape"] == want), None)
     value = described["parameters"].get(key, float("nan")) if described else float("nan")
+    fitted = (diag.get("missing_force") or {}).get("fitted_shape") or {}
+    if fitted.get("stands") and not stands_out:  # the description the diagnosis gives then
+        best, stands_out = {"shape": f"{fitted['shape']} (as a term)"}, True
+        value = fitted["parameters"].get(key, float("nan")) if fitted["shape"] == want \
+            else float("nan")
     line = (diag.get("missing_force") or {}).get("residual_line")
     if name == "mains_hum" and line and not (stands_out and best["shape"] == want):
         best, value, stands_out = {"shape": "line in the residual"}, line["frequency_hz"], True

@@ -81,7 +81,9 @@ def test_a_residual_the_smoother_cannot_carry_is_not_called_no_missing_force():
     lf = SimpleNamespace(noise_sd=2.8e-4, baseline_noise_sd=2.8e-4, force=np.full(50, 0.1),
                          sd=np.full(50, 0.2))
     missing = SimpleNamespace(latent=lf, sizes=[], description=SimpleNamespace(
-        sentence="no missing force beyond its uncertainty (RMS 0.1 N against an sd of 0.2 N)"))
+        sentence="no missing force beyond its uncertainty (RMS 0.1 N against an sd of 0.2 N)"),
+        fitted_shape=None)
+    missing.sentence = lambda: missing.description.sentence
     floor = SimpleNamespace(rms=1.0, bound="upper", method="repeated_periods")
     far = FitJudgement(0.95, 0.227, "holdout", 15.0, floor)
     assert latent_unread(missing, far, 3.0)

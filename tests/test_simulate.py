@@ -128,6 +128,7 @@ TERM_PARAMS = {
     "unmodelled_mode": [6.0, 0.05, 0.5, 1.0],
     "inertia_error": [0.8, 0.5],
     "offset_force": [3.0],
+    "periodic_force": [3.0, 1.0, 0.005],
 }
 
 

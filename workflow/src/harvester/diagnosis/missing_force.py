@@ -20,6 +20,7 @@ from harvester.diagnosis.relevance import (EffectSize, OwnForce, RelevanceFloor,
                                            effect_size, own_span, response_change, ridge,
                                            term_force_rms)
 from harvester.diagnosis.shapes import ShapeDescription, describe
+from harvester.diagnosis.shape_terms import ShapeTermFit
 from harvester.model.structures import ModelStructure
 
 
@@ -54,6 +55,17 @@ class MissingForce:
     #: several named terms' own forces summed, over the one fit that holds them all
     #: (:func:`together_force`)
     together: OwnForce | None = None
+    #: the dictionary's periodic shape fitted as a term of the model (``shape_terms``)
+    fitted_shape: ShapeTermFit | None = None
+
+    def sentence(self) -> str:
+        """What the missing force looks like: the description's sentence, or the shape
+        fitted as a term's where it stands and the smoother could not read the force, or
+        where it beat the named effects (``verdict.withheld_names``)."""
+        fs = self.fitted_shape
+        if fs is not None and fs.stands and (fs.beats_names or not self.description.readable):
+            return fs.sentence()
+        return self.description.sentence
 
     def to_dict(self) -> dict:
         """diagnosis.json's ``missing_force`` entry."""
@@ -67,7 +79,9 @@ class MissingForce:
                                   else self.residual_line.to_dict()),
                 "together": (None if self.together is None else
                              {"terms": [e.term for e in self.effects],
-                              **self.together.to_dict()})}
+                              **self.together.to_dict()}),
+                "fitted_shape": (None if self.fitted_shape is None
+                                 else self.fitted_shape.to_dict())}
 
 
 def missing_force(state: BaselineState, window: tuple[int, int] | None = None,

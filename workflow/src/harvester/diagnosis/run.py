@@ -31,10 +31,11 @@ from harvester.diagnosis.detect import Detection, band_top, detect, estimate_tem
 from harvester.diagnosis.report import UnseenFit, unseen_fit
 from harvester.diagnosis.rounds import Round, run_rounds
 from harvester.diagnosis.settings import DiagnosisSettings
-from harvester.diagnosis.signatures import candidate_terms
+from harvester.diagnosis.signatures import candidate_terms, motion_scale
 from harvester.diagnosis.spectral import recording_lowpass
 from harvester.diagnosis.floor import Floor, output_floor
 from harvester.diagnosis.missing_force import MissingForce, NamedEffect, missing_force
+from harvester.diagnosis.shape_terms import ShapeTermFit, shape_term_fit
 from harvester.diagnosis.relevance import RelevanceFloor
 from harvester.diagnosis.verdict import (Conclusion, FitJudgement, Tie, conclude,
                                           decide_verdict, judge, nominated_terms)
@@ -188,7 +189,7 @@ def _pass(analysis: Analysis, start: BaselineStart, settings: DiagnosisSettings,
     before, after, more = unseen_comparison(analysis, start, found.improved_fit, settings)
     fit = fit_judgement(start, rounds[0], before, after)
     missing, missing_notes = estimate_missing_force(analysis, rounds[0].state, found, settings,
-                                                    fit.floor)
+                                                    fit.floor, start)
     return _Pass(rounds, baseline_fit, found, (before, after), fit, missing, notes,
                  more + missing_notes)
 
@@ -229,14 +230,17 @@ def fit_judgement(start: BaselineStart, first: Round, before: UnseenFit | None,
 
 
 def estimate_missing_force(a: Analysis, state: BaselineState, found: Conclusion,
-                           settings: DiagnosisSettings, floor: Floor | None = None
+                           settings: DiagnosisSettings, floor: Floor | None = None,
+                           start: BaselineStart | None = None
                            ) -> tuple[MissingForce | None, list[str]]:
     """The baseline's missing force (``missing_force``) over the analysed window, with each
     effect the improved model added beside it and its size on the unseen input (the validation
     record's or the held-out tail's); None with a note where it cannot be estimated. On a
     record that fixes the slow motion (a displacement) the smoother's noise is the
     recording's own ``floor`` where it shows one (``floor.py``; at most the baseline's
-    sigma), so that what the baseline leaves beyond the noise is force (``latent``)."""
+    sigma), so that what the baseline leaves beyond the noise is force (``latent``). With the
+    baseline's ``start``, the dictionary's periodic shape is also fitted as a term of the
+    model (``shape_terms``), against the baseline and the improved model."""
     if not settings.missing_force:
         return None, []
     named = named_effects(a.structure, found)
@@ -259,7 +263,26 @@ def estimate_missing_force(a: Analysis, state: BaselineState, found: Conclusion,
         log.warning("missing force not estimated: %s", err)
         return None, [f"missing force not estimated: {err}"]
     log.info("missing force: %s (%.1f s)", out.description.sentence, time.perf_counter() - clock)
+    if start is not None:
+        out.fitted_shape = fitted_shape(a, state, start, found.improved_fit, settings)
     return out, []
+
+
+def fitted_shape(a: Analysis, state: BaselineState, start: BaselineStart,
+                 improved: ModelFit | None, settings: DiagnosisSettings
+                 ) -> ShapeTermFit | None:
+    """The dictionary's periodic shape fitted as a term of the model (``shape_terms``) over
+    the detection's window, against the baseline and the ``improved`` model (the named
+    effects'; None without); None with a warning where a simulation fails."""
+    window = (a.lead, a.hold)
+    try:
+        return shape_term_fit(start.detection_problem, start.priors, start.samples,
+                              state.rel_disp[a.lead:a.hold], state.rel_vel[a.lead:a.hold],
+                              motion_scale(state, window, a.f_high), a.f_high,
+                              improved, settings.units, settings.seed)
+    except (RuntimeError, np.linalg.LinAlgError) as err:
+        log.warning("the periodic shape was not fitted as a term: %s", err)
+        return None
 
 
 def named_effects(baseline: ModelStructure, found: Conclusion) -> list[NamedEffect]:

@@ -109,9 +109,10 @@ def motion_scale(state: BaselineState, window: tuple[int, int], f_high: float) -
 
 def candidate_terms(structure_terms: tuple[str, ...], allowed: tuple[str, ...] | None = None
                     ) -> list[str]:
-    """Library terms that can be added to a structure: not already in it and, for a
-    refinement of another law (``Term.refines``), with that law in the structure."""
-    names = [t for t in TERMS if t not in structure_terms
+    """Library terms that can be added to a structure: nameable (``Term.nameable``), not
+    already in it and, for a refinement of another law (``Term.refines``), with that law in
+    the structure."""
+    names = [t for t in TERMS if t not in structure_terms and TERMS[t].nameable
              and (not TERMS[t].refines or set(TERMS[t].refines) & set(structure_terms))]
     if allowed is not None:
         unknown = [t for t in allowed if t not in TERMS]

@@ -79,6 +79,11 @@ def _missing_lines(doc: Mapping[str, Any]) -> list[str]:
     if (mf.get("shape") or {}).get("sentence"):
         lines.append(f"the missing force, seen without the library: "
                      f"{_esc(mf['shape']['sentence'])}")
+    shaped = mf.get("fitted_shape") or {}
+    if shaped.get("stands"):
+        lines.append(f"fitted as a term of the model: {_esc(shaped['sentence'])}"
+                     + (f"; {_esc(shaped['named'])} gains {shaped['named_gain_nats']:+.0f} "
+                        "nats by the same measure" if shaped.get("named") else ""))
     for tie in doc.get("ties") or []:
         lines.append("cannot tell apart " + " / ".join(_esc(e) for e in tie.get("effects", []))
                      + (f"; the experiment that would: {_esc(tie['recommended'])}"

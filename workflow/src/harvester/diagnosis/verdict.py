@@ -227,7 +227,18 @@ def withheld_names(found: Conclusion, missing: MissingForce | None) -> str | Non
     library holds whose terms the rounds screened or sampled (``Conclusion.tried``) does not
     overrule the evidence, which fitted those terms to the record itself: LuGre's and
     Bouc-Wen's hysteresis were withheld for "odd in z" at 31 % and 14 % of an acceleration
-    record's latent force, whose cubic spring and end stop had fallen short by evidence."""
+    record's latent force, whose cubic spring and end stop had fallen short by evidence.
+    Before that, a shape fitted as a term of the model (``MissingForce.fitted_shape``) that
+    beats the named effects' model by evidence (``ShapeTermFit.beats_names``) withholds
+    them too: it sees z where the smoother cannot (a cogging record's detent, named a
+    pre-sliding hysteresis)."""
+    shaped = None if missing is None else missing.fitted_shape
+    if shaped is not None and shaped.beats_names and (found.missing or found.ties):
+        names = found.missing + [e for t in found.ties for e in t.effects]
+        return (f"{' + '.join(names)} accepted by evidence, but {shaped.sentence()}, fits the "
+                f"record better than {shaped.named} by "
+                f"{shaped.gain_nats - shaped.named_gain_nats:.0f} nats (Laplace, each at its "
+                "best fit), a shape none of them has: not named")
     sizes = [] if missing is None else [s for s in missing.sizes if not s.negligible]
     if not sizes or not (found.missing or found.ties):
         return None
@@ -313,6 +324,9 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
     if verdict == "adequate" and missing is not None and missing.description.readable:
         notes.append("below the verdict's bar, the missing force still stands out of its "
                      f"uncertainty: {missing.description.sentence}")
+    shaped = None if missing is None else missing.fitted_shape
+    if verdict == "adequate" and shaped is not None and shaped.stands:
+        notes.append(f"below the verdict's bar, {shaped.sentence()}")
     if missing is not None and missing.residual_line is not None:
         notes.append(missing.residual_line.sentence())
     if fit.floor is None:
@@ -417,11 +431,12 @@ def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
     share = fit.library_share()
     if verdict != "adequate":
         parts.append(_library_phrase(share, found.accepted))
-        if not found.accepted and latent_unread(missing, fit, limit):
+        shaped = missing is not None and missing.sentence() != missing.description.sentence
+        if not found.accepted and not shaped and latent_unread(missing, fit, limit):
             parts.append("the missing force: not readable by the smoother (its noise took the "
                          "whole residual)")
         elif (not found.accepted or found.withheld) and missing is not None:
-            parts.append(f"the missing force: {missing.description.sentence}")
+            parts.append(f"the missing force: {missing.sentence()}")
     return "; ".join(parts)
 
 

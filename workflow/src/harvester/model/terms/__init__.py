@@ -147,6 +147,9 @@ class Term:
     parameter's prior the term stands for another (a pre-sliding displacement below what the
     data resolve is Coulomb friction; a mode far above the band is a mass). A posterior piled
     there is not trusted, and the diagnosis samples the other term in its place.
+    ``nameable``: False for a shape of the missing force's dictionary fitted as a term
+    (``diagnosis.shape_terms``): it describes what the library lacks and is never a
+    candidate the diagnosis names.
     """
 
     name: str
@@ -164,6 +167,7 @@ class Term:
     refines: tuple[str, ...] = ()
     alike: tuple[str, ...] = ()
     limits: tuple[tuple[str, str, str], ...] = ()
+    nameable: bool = True
     source: str = field(default="", compare=False)  # the file that defines the term
 
     def limit(self, parameter: str, side: str) -> str | None:
