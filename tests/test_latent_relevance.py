@@ -82,7 +82,7 @@ def test_a_residual_the_smoother_cannot_carry_is_not_called_no_missing_force():
                          sd=np.full(50, 0.2))
     missing = SimpleNamespace(latent=lf, sizes=[], description=SimpleNamespace(
         sentence="no missing force beyond its uncertainty (RMS 0.1 N against an sd of 0.2 N)"),
-        fitted_shape=None)
+        fitted_shape=None, shape_speaks=False)
     missing.sentence = lambda: missing.description.sentence
     floor = SimpleNamespace(rms=1.0, bound="upper", method="repeated_periods")
     far = FitJudgement(0.95, 0.227, "holdout", 15.0, floor)

@@ -119,3 +119,4 @@ def test_a_fitted_shape_that_beats_the_names_withholds_them():
     assert judged.missing == [] and judged.withheld == ["cubic_stiffness"]
     assert "the missing force: a force periodic in z, period 0.1 mm" in judged.headline
     assert out.to_dict()["fitted_shape"]["beats_names"] is True
+    assert out.to_dict()["fitted_shape"]["speaks"] is True

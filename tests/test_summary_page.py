@@ -83,17 +83,17 @@ def test_names_sized_together_are_said_with_their_interval(tmp_path):
 
 
 def test_a_shape_fitted_as_a_term_is_said_where_it_speaks(tmp_path):
-    """The periodic shape fitted as a term (``shape_terms``) is said where it withheld the
-    names; beside names whose model beats it, it is not (a flexible shape takes part of
-    their force)."""
-    shaped = {"stands": True, "beats_names": True, "named": "tanh+hysteresis",
+    """The periodic shape fitted as a term (``shape_terms``) is said where it speaks
+    (``MissingForce.shape_speaks``: it withheld the names); elsewhere it is not (beside
+    names whose model beats it, a flexible shape takes part of their force)."""
+    shaped = {"speaks": True, "named": "tanh+hysteresis",
               "named_gain_nats": 91.0, "sentence": "a force periodic in z, period 0.101 mm"}
     doc = {**DOC, "missing": [], "withheld": ["hysteresis"],
            "missing_force": {"fitted_shape": shaped}}
     page = summary_page(doc, tmp_path, "t")
     assert ("fitted as a term of the model: a force periodic in z, period 0.101 mm; "
             "tanh+hysteresis gains +91 nats by the same measure") in page
-    beaten = {**shaped, "beats_names": False}
+    beaten = {**shaped, "speaks": False}
     page = summary_page({**DOC, "missing_force": {"fitted_shape": beaten}}, tmp_path, "t")
     assert "fitted as a term" not in page
 

@@ -62,10 +62,17 @@ class MissingForce:
         """What the missing force looks like: the description's sentence, or the shape
         fitted as a term's where it stands and the smoother could not read the force, or
         where it beat the named effects (``verdict.withheld_names``)."""
+        return self.fitted_shape.sentence() if self.shape_speaks else self.description.sentence
+
+    @property
+    def shape_speaks(self) -> bool:
+        """Whether the shape fitted as a term is what the diagnosis says of the missing force:
+        it stands, and it beat the named effects or the smoother could not read the force
+        (beside names whose model beats it, it is a flexible shape taking part of their
+        force: +321 nats on the frame at 250 g against the hysteresis model's +420)."""
         fs = self.fitted_shape
-        if fs is not None and fs.stands and (fs.beats_names or not self.description.readable):
-            return fs.sentence()
-        return self.description.sentence
+        return bool(fs is not None and fs.stands
+                    and (fs.beats_names or not self.description.readable))
 
     def to_dict(self) -> dict:
         """diagnosis.json's ``missing_force`` entry."""
@@ -80,8 +87,8 @@ class MissingForce:
                 "together": (None if self.together is None else
                              {"terms": [e.term for e in self.effects],
                               **self.together.to_dict()}),
-                "fitted_shape": (None if self.fitted_shape is None
-                                 else self.fitted_shape.to_dict())}
+                "fitted_shape": (None if self.fitted_shape is None else
+                                 {**self.fitted_shape.to_dict(), "speaks": self.shape_speaks})}
 
 
 def missing_force(state: BaselineState, window: tuple[int, int] | None = None,

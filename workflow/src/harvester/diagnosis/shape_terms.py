@@ -205,7 +205,9 @@ def shape_term_fit(problem: ChainProblem,
     clock = time.perf_counter()
     base = fit_map(problem, priors, seed=seed, start=samples.mean(axis=0)[:-1])
     found = fit_periodic(problem, priors, base, z, v, scale, f_high, seed)
-    if found is None:
+    if found is None:  # the Silverbox: two periods within +-2 RMS would lie beyond the band
+        log.info("the periodic shape is not fitted as a term: no period of its prior lies "
+                 "within the band at the motion's RMS velocity")
         return None
     fit, n = found
     values = dict(zip(fit.names, fit.theta))

@@ -80,10 +80,7 @@ def _missing_lines(doc: Mapping[str, Any]) -> list[str]:
         lines.append(f"the missing force, seen without the library: "
                      f"{_esc(mf['shape']['sentence'])}")
     shaped = mf.get("fitted_shape") or {}
-    # where it speaks: it withheld the names, or none were given (beside names that beat it,
-    # it is a flexible shape taking part of their force: +321 nats on the frame at 250 g
-    # against the hysteresis model's +420)
-    if shaped.get("stands") and (shaped.get("beats_names") or not doc.get("missing")):
+    if shaped.get("speaks"):  # ``MissingForce.shape_speaks``
         lines.append(f"fitted as a term of the model: {_esc(shaped['sentence'])}"
                      + (f"; {_esc(shaped['named'])} gains {shaped['named_gain_nats']:+.0f} "
                         "nats by the same measure" if shaped.get("named") else ""))

@@ -324,9 +324,8 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
     if verdict == "adequate" and missing is not None and missing.description.readable:
         notes.append("below the verdict's bar, the missing force still stands out of its "
                      f"uncertainty: {missing.description.sentence}")
-    shaped = None if missing is None else missing.fitted_shape
-    if verdict == "adequate" and shaped is not None and shaped.stands:
-        notes.append(f"below the verdict's bar, {shaped.sentence()}")
+    if verdict == "adequate" and missing is not None and missing.shape_speaks:
+        notes.append(f"below the verdict's bar, {missing.sentence()}")
     if missing is not None and missing.residual_line is not None:
         notes.append(missing.residual_line.sentence())
     if fit.floor is None:
@@ -431,7 +430,7 @@ def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
     share = fit.library_share()
     if verdict != "adequate":
         parts.append(_library_phrase(share, found.accepted))
-        shaped = missing is not None and missing.sentence() != missing.description.sentence
+        shaped = missing is not None and missing.shape_speaks
         if not found.accepted and not shaped and latent_unread(missing, fit, limit):
             parts.append("the missing force: not readable by the smoother (its noise took the "
                          "whole residual)")
