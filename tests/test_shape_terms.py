@@ -84,12 +84,12 @@ def test_the_grid_keeps_within_the_band_and_the_prior():
     z = np.sin(np.linspace(0.0, 60.0, 6000)) * 1e-3
     v = np.full_like(z, 1e-3)
     specs = {"P_periodic": PriorSpec.log_uniform("P_periodic", 2e-5, 2e-3, "m")}
-    grid = period_grid(z, v, None, 20.0, specs)
+    grid = period_grid(z, v, 20.0, specs)
     span = float(np.subtract(*np.quantile(z, [0.99, 0.01])))
     assert grid.min() >= 1e-3 / 20.0 - 1e-12 and grid.max() <= 2e-3
     assert np.allclose(np.diff(span / grid[::-1]), -0.5) or np.allclose(
         np.diff(span / grid), 0.5)
-    assert period_grid(np.zeros(10), v[:10], None, 20.0, specs).size == 0
+    assert period_grid(np.zeros(10), v[:10], 20.0, specs).size == 0
 
 
 def test_a_fitted_shape_that_beats_the_names_withholds_them():

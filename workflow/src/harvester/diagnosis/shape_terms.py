@@ -118,13 +118,18 @@ class ShapeTermFit:
                 "seconds": self.seconds, "sentence": self.sentence()}
 
 
-def period_grid(z: np.ndarray, v: np.ndarray, scale: DeviceScale, f_high: float,
+def _span(z: np.ndarray) -> float:
+    """The motion's span (m): its 1-99 % range."""
+    return float(np.subtract(*np.quantile(z, [0.99, 0.01])))
+
+
+def period_grid(z: np.ndarray, v: np.ndarray, f_high: float,
                 specs: dict[str, PriorSpec]) -> np.ndarray:
     """Periods (m) to start from: within P_periodic's prior and above the period a force
     at the RMS velocity would have at the band's top (v_rms / f_high: finer, it lies beyond
-    the analysed band), PERIOD_STEP of a period over the motion's span (its 1-99 %
-    range) apart, MAX_PERIODS at most."""
-    span = float(np.subtract(*np.quantile(z, [0.99, 0.01])))
+    the analysed band), PERIOD_STEP of a period over the motion's span (:func:`_span`)
+    apart, MAX_PERIODS at most."""
+    span = _span(z)
     prior = specs["P_periodic"]
     low = max(prior.lower, float(np.sqrt(np.mean(v**2))) / f_high)
     high = prior.upper
@@ -179,14 +184,13 @@ def fit_periodic(problem: ChainProblem, priors: dict[str, PriorSpec], base: Poin
     added = chain_problem(p, p.temper, p.lowpass_hz, p.filter_order,
                           structure=p.structure.with_term(PERIODIC))
     specs = {**candidate_priors(PERIODIC, scale), **priors}
-    periods = period_grid(z, v, scale, f_high, specs)
+    periods = period_grid(z, v, f_high, specs)
     if periods.size == 0:
         return None
     shared = base.theta[:-1]
     coarse = _best_rows(added, _grid_rows(shared, periods, scale.force * np.array(AMPLITUDES),
                                           PHASES), REFINE_ROWS)
-    span = float(np.subtract(*np.quantile(z, [0.99, 0.01])))
-    best = _best_rows(added, np.vstack([coarse, _refined(shared, coarse, span)]), STARTS)
+    best = _best_rows(added, np.vstack([coarse, _refined(shared, coarse, _span(z))]), STARTS)
     # and the baseline itself (no force), solved from where it beats the grid's rows: from
     # those alone an effect-free record's fit ended 214 nats below the baseline
     none = np.r_[shared, 0.0, 0.0, periods[len(periods) // 2]]
@@ -215,9 +219,10 @@ def shape_term_fit(problem: ChainProblem,
     values = dict(zip(fit.names, fit.theta))
     a, b, P = values["a_periodic"], values["b_periodic"], values["P_periodic"]
     named_gain = None
-    if improved is not None:
-        named = fit_map(improved.problem, improved.priors, seed=seed,
-                        start=improved.samples.mean(axis=0)[:-1])
+    if improved is not None:  # on the baseline's data: its TMCMC window may be shorter
+        named = fit_map(chain_problem(problem, problem.temper, problem.lowpass_hz,
+                                      problem.filter_order, structure=improved.structure),
+                        improved.priors, seed=seed, start=improved.samples.mean(axis=0)[:-1])
         named_gain = named.log_evidence_laplace - base.log_evidence_laplace
     out = ShapeTermFit("periodic in z", PERIODIC,
                        {"period_m": float(P), "amplitude_N": float(np.hypot(a, b)),
