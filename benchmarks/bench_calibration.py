@@ -11,7 +11,7 @@ nominal rate it should stay under (the evidence's alpha plus ``unexplained_alpha
 Part 2 (``--power``): the concealed-effect grid's library effects at several strengths
 (contribution / noise RMS), detection only (``quick_detect``: MAP baseline, the default 400
 replicates). For each record the library family's p-value by rank (what it was before the tail
-was modelled, never below 1/401) and by the tail model (``diagnosis.tail``); the share of
+was modelled, never below 1/401) and by the tail model (``inference.tail``); the share of
 records below alpha = 0.05 and below unexplained_alpha = 0.001 under each.
 
     python benchmarks/bench_calibration.py [--seeds 10] [--duration 20] [--fast]

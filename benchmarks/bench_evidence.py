@@ -19,8 +19,8 @@ import time
 
 import numpy as np
 
-from harvester.diagnosis.baseline import chain_problem
-from harvester.diagnosis.confirm import ConfirmSettings, bridge_evidence
+from harvester.inference.map_fit import chain_problem
+from harvester.diagnosis.name.confirm import ConfirmSettings, bridge_evidence
 from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
 from harvester.inference.identify import identify
 from harvester.inference.problems import make_problem

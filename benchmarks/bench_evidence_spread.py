@@ -26,12 +26,12 @@ from dataclasses import replace
 
 import numpy as np
 
-from harvester.diagnosis.baseline import baseline_state, chain_problem, fit_map
-from harvester.diagnosis.confirm import candidate_fit, fit_structure
-from harvester.diagnosis.detect import detect, estimate_temper
+from harvester.inference.map_fit import baseline_state, chain_problem, fit_map
+from harvester.diagnosis.name.confirm import candidate_fit, fit_structure
+from harvester.diagnosis.detect.scores import detect, estimate_temper
 from harvester.diagnosis.run import DiagnosisSettings, default_priors, velocity_bound
-from harvester.diagnosis.signatures import candidate_terms, motion_scale
-from harvester.diagnosis.spectral import filter_cutoff
+from harvester.diagnosis.detect.signatures import candidate_terms, motion_scale
+from harvester.diagnosis.detect.spectral import filter_cutoff
 from harvester.inference.problems import make_problem
 from harvester.synthetic.scenarios import ScenarioSettings, make_scenario
 

@@ -35,8 +35,8 @@ from harvester.inference.priors import PriorSpec
 OLD_SIDE = r"""
 import json, sys
 import numpy as np
-from harvester.diagnosis.fits import candidate_priors
-from harvester.diagnosis.signatures import MotionScale
+from harvester.diagnosis.name.fits import candidate_priors
+from harvester.diagnosis.detect.signatures import MotionScale
 out = []
 for job in json.load(sys.stdin):
     s = job["scale"]

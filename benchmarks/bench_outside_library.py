@@ -10,7 +10,7 @@ low-pass), each with its sidecar (the "known" M, m, k), then ``harvester diagnos
 --baseline tanh --no-figures`` at the default settings. One row per record: scenario, seed,
 verdict, names given, the described shape, its parameter, the truth's, their ratio, and the
 diagnosis's wall time. For the mains hum, a line the missing force leaves in the recording
-(``diagnosis.lines``) stands in for the force's line when that is not read.
+(``diagnosis.size.lines``) stands in for the force's line when that is not read.
 
     python benchmarks/bench_outside_library.py [--ratio 1] [--fast] [--seeds 0 1]
         [--scenarios cogging ...] [--out DIR]
@@ -93,11 +93,11 @@ def describe_only(csv: Path, truth: dict) -> tuple[dict, float]:
     under its likelihood, the analysed window), without the rounds that name library terms:
     a diagnosis.json-like dict with verdict "(not run)" (``--describe-only``)."""
     from harvester.data.daq import read_recording
-    from harvester.diagnosis.analysis import prepare, start_baseline
-    from harvester.diagnosis.baseline import baseline_state
-    from harvester.diagnosis.missing_force import missing_force
+    from harvester.diagnosis.prepare.analysis import prepare, start_baseline
+    from harvester.inference.map_fit import baseline_state
+    from harvester.diagnosis.size.missing_force import missing_force
     from harvester.diagnosis.run import fitted_shape
-    from harvester.diagnosis.settings import DiagnosisSettings
+    from harvester.diagnosis.prepare.settings import DiagnosisSettings
     from harvester.initial.recording import diagnosis_priors
 
     clock = time.perf_counter()

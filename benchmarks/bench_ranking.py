@@ -1,7 +1,7 @@
 """The detection's linearised ranking against each candidate's MAP, on grid records.
 
 For each record (a grid scenario's CSV beside its JSON, as ``snakemake detection_all``
-writes them) it prints, per candidate effect: the ranking's delta chi^2 (``diagnosis.rank``,
+writes them) it prints, per candidate effect: the ranking's delta chi^2 (``diagnosis.name.rank``,
 the signatures linearised at a small strength) and the gain of the candidate's posterior mode
 over the baseline's best (``baseline.fit_map``: profiled sigma, the tempered objective
 lambda n/2 log RSS, in nats; the baseline's MAP is also started from each candidate's values
@@ -22,13 +22,13 @@ import numpy as np
 
 from harvester.data.daq import read_recording
 from harvester.data.fileio import read_json
-from harvester.diagnosis.analysis import default_priors
-from harvester.diagnosis.baseline import chain_problem, fit_map
-from harvester.diagnosis.fits import candidate_priors
-from harvester.diagnosis.rank import rank
+from harvester.diagnosis.prepare.analysis import default_priors
+from harvester.inference.map_fit import chain_problem, fit_map
+from harvester.diagnosis.name.fits import candidate_priors
+from harvester.diagnosis.name.rank import rank
 from harvester.diagnosis.run import quick_detect
-from harvester.diagnosis.settings import DiagnosisSettings
-from harvester.diagnosis.signatures import motion_scale
+from harvester.diagnosis.prepare.settings import DiagnosisSettings
+from harvester.diagnosis.detect.signatures import motion_scale
 from harvester.model.structures import structure
 
 

@@ -24,11 +24,11 @@ import numpy as np
 import yaml
 
 from harvester.grid.scoring import SIGMA_PRIOR
-from harvester.diagnosis.baseline import baseline_state, chain_problem, fit_map
-from harvester.diagnosis.confirm import ConfirmSettings, confirm, fit_structure
-from harvester.diagnosis.detect import DetectionSettings, detect, estimate_temper
+from harvester.inference.map_fit import baseline_state, chain_problem, fit_map
+from harvester.diagnosis.name.confirm import ConfirmSettings, confirm, fit_structure
+from harvester.diagnosis.detect.scores import DetectionSettings, detect, estimate_temper
 from harvester.diagnosis.run import default_priors
-from harvester.diagnosis.signatures import motion_scale
+from harvester.diagnosis.detect.signatures import motion_scale
 from harvester.inference.problems import make_problem
 from harvester.inference.priors import PriorSpec
 from harvester.synthetic.scenarios import ScenarioSettings, make_scenario

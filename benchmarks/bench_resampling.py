@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 
-from harvester.diagnosis.baseline import chain_problem, fit_map
+from harvester.inference.map_fit import chain_problem, fit_map
 from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
 from harvester.inference.problems import make_problem
 from harvester.inference.priors import PriorSpec

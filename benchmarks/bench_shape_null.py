@@ -11,7 +11,7 @@ best shape, its standing (sd, referred to its coefficients, ``shapes.standing``)
 largest standing of any shape, and whether the force was read; then the rate of reads with
 its 95 % Wilson interval, the standings' quantiles, and the threshold at which the records
 would read at the nominal rate; beside it, the periodic shape fitted as a term of the model
-(``diagnosis.shape_terms``): its gain, its period, and the rate at which it stands. A record
+(``diagnosis.size.shape_terms``): its gain, its period, and the rate at which it stands. A record
 already in ``--out`` is reused (its description is recomputed).
 
     python benchmarks/bench_shape_null.py [--seeds 0 1 ... | --first 0 --count 60]
@@ -29,8 +29,8 @@ import numpy as np
 
 from bench_outside_library import describe_only, make_record
 from harvester.data.errors import DataError
-from harvester.diagnosis.shape_terms import STAND_NATS
-from harvester.diagnosis.shapes import SHAPE_SD
+from harvester.diagnosis.size.shape_terms import STAND_NATS
+from harvester.diagnosis.size.shapes import SHAPE_SD
 from harvester.grid.scoring import wilson_interval
 
 
@@ -44,7 +44,7 @@ def standings(diag: dict) -> tuple[str, float, float, bool]:
 
 
 def fitted(diag: dict) -> tuple[float, float, bool]:
-    """The periodic shape fitted as a term (``diagnosis.shape_terms``): (its Laplace gain
+    """The periodic shape fitted as a term (``diagnosis.size.shape_terms``): (its Laplace gain
     over the baseline, nats; its period, m; whether it stands)."""
     fs = (diag.get("missing_force") or {}).get("fitted_shape") or {}
     return (float(fs.get("gain_nats", np.nan)),

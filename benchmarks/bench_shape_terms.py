@@ -1,4 +1,4 @@
-"""The periodic shape fitted as a term of the model (``diagnosis.shape_terms``) against the
+"""The periodic shape fitted as a term of the model (``diagnosis.size.shape_terms``) against the
 name the library should give (issue 43): on records of the literature grid with a library
 effect, how far the shape's gain stays below the named model's (a name it would withhold
 wrongly), and on records of forms outside the library, whether it stands with the right
@@ -6,7 +6,7 @@ period.
 
 Each record (``--records`` files with the generator's truth beside them, or the grid's
 ``--scenarios`` at ``--seeds``, made as ``bench_outside_library.make_record`` makes them) is
-read as the diagnosis reads it (``diagnosis.analysis.model_input``, ``initial.recording``'s
+read as the diagnosis reads it (``diagnosis.prepare.analysis.model_input``, ``initial.recording``'s
 priors with the grid's sigma prior), its tanh baseline fitted by MAP over the first 75 % less
 half a second after a 1 s lead-in, tempered for correlated residuals
 (``detect.estimate_temper``); then the first correct name's model by MAP (none for a form
@@ -35,12 +35,12 @@ import pandas as pd
 
 from bench_outside_library import make_record
 from harvester.data.signals import uniform_step
-from harvester.diagnosis.analysis import model_input
-from harvester.diagnosis.baseline import baseline_state, chain_problem, fit_map
-from harvester.diagnosis.detect import band_top, estimate_temper
-from harvester.diagnosis.fits import candidate_priors
-from harvester.diagnosis.shape_terms import shape_term_fit
-from harvester.diagnosis.signatures import motion_scale
+from harvester.diagnosis.prepare.analysis import model_input
+from harvester.inference.map_fit import baseline_state, chain_problem, fit_map
+from harvester.diagnosis.detect.scores import band_top, estimate_temper
+from harvester.diagnosis.name.fits import candidate_priors
+from harvester.diagnosis.size.shape_terms import shape_term_fit
+from harvester.diagnosis.detect.signatures import motion_scale
 from harvester.grid.information import REFIT_SIGMA
 from harvester.inference.problems import make_problem
 from harvester.initial.recording import recording_priors

@@ -12,7 +12,7 @@ likelihood evaluations and their rate. Run: ``make benchmark`` (``--particles``,
 
 Three comparisons, because the tool does not decide on TMCMC's own estimate: every evidence
 the diagnosis compares is re-estimated by bridge sampling from the final population
-(``harvester.inference.evidence``, ``diagnosis.confirm.bridge_evidence``), here from each
+(``harvester.inference.evidence``, ``diagnosis.name.confirm.bridge_evidence``), here from each
 chain alone. (1) the kernels, each with its own product of mean weights; (2) what each tool
 reports: ours re-estimated by bridge sampling (its time added) against IMH's own; (3) both
 re-estimated by bridge sampling, which shows how much of (2) is the estimator, open to any
@@ -35,7 +35,7 @@ from scipy import stats
 
 from harvester.data.daq import read_raw_record, to_accelerations
 from harvester.data.signals import filter_recording
-from harvester.diagnosis.confirm import bridge_evidence
+from harvester.diagnosis.name.confirm import bridge_evidence
 from harvester.inference.problems import make_problem
 from harvester.inference.priors import prior_moments, priors_for
 from harvester.inference.pymc_model import build_model

@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 
 from harvester.data.signals import lowpass
-from harvester.diagnosis.baseline import BaselineState, ChainProblem, baseline_state
+from harvester.inference.map_fit import BaselineState, ChainProblem, baseline_state
 from harvester.inference.likelihood import DAQ_OVERSAMPLE
 from harvester.synthetic.measured import TABLE1_KNOWN, base_excitation
 

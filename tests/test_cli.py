@@ -12,7 +12,7 @@ import pytest
 
 from harvester.cli import main
 from harvester.data.daq import write_recording
-from harvester.diagnosis.fits import candidate_priors
+from harvester.diagnosis.name.fits import candidate_priors
 from harvester.model.priors import DeviceScale
 from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
 from harvester.initial.recording import recording_priors

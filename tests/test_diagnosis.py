@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 
 from harvester.diagnosis import DiagnosisSettings, quick_detect
-from harvester.diagnosis.verdict import decide_verdict
-from harvester.diagnosis.baseline import ChainProblem, chain_problem
-from harvester.diagnosis.detect import estimate_temper
-from harvester.diagnosis.rank import rank
-from harvester.diagnosis.spectral import filter_cutoff
+from harvester.diagnosis.name.verdict import decide_verdict
+from harvester.inference.map_fit import ChainProblem, chain_problem
+from harvester.diagnosis.detect.scores import estimate_temper
+from harvester.diagnosis.name.rank import rank
+from harvester.diagnosis.detect.spectral import filter_cutoff
 from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
 from harvester.inference.problems import make_problem
 from harvester.inference.likelihood import DAQ_OVERSAMPLE
@@ -66,7 +66,7 @@ def test_a_low_pass_given_as_none_is_not_looked_for_and_a_shared_roll_off_is_not
     octaves higher; a sidecar may say ``filtered_at_hz: 0``, not a negative cut-off."""
     from harvester.data.errors import DataError
     from harvester.data.sidecar import read_sidecar
-    from harvester.diagnosis.spectral import recording_lowpass, shared_roll_off
+    from harvester.diagnosis.detect.spectral import recording_lowpass, shared_roll_off
     rng = np.random.default_rng(1)
     u, y = rng.standard_normal((2, 20 * 256))
     y20 = lowpass(y, FS, 20.0, 8)
@@ -239,7 +239,7 @@ def test_backlash_contact_prior_puts_the_contact_resonance_above_the_band():
 def test_the_dissipative_force_is_the_power_the_base_puts_in():
     """c_eq sigma_v from the base's power input matches the simulated dissipation (viscous
     plus tanh friction) on a noisy low-passed recording, without knowing the split."""
-    from harvester.diagnosis.signatures import dissipative_force
+    from harvester.diagnosis.detect.signatures import dissipative_force
     from harvester.synthetic.measured import base_excitation
     from harvester.model.simulate import simulate
 
@@ -262,7 +262,7 @@ def test_candidate_priors_follow_the_device_from_the_papers_rig():
     the dissipative force, 3x the velocity and twice M and k they follow the device."""
     from dataclasses import replace as dc_replace
 
-    from harvester.diagnosis.fits import candidate_priors
+    from harvester.diagnosis.name.fits import candidate_priors
     from harvester.model.priors import REFERENCE_DEVICE
 
     rig = REFERENCE_DEVICE
@@ -286,12 +286,12 @@ def test_candidate_priors_follow_the_device_from_the_papers_rig():
         4 * candidate_priors("quadratic_damping", rig)["c_quad"].upper * rig.v**2)
 
 def _result(effect, delta, se=0.3, accepted=True):
-    from harvester.diagnosis.confirm import CandidateResult
+    from harvester.diagnosis.name.confirm import CandidateResult
     return CandidateResult(effect, None, delta, se, 3.0 + 2 * se, accepted)
 
 
 def test_an_effect_is_named_alone_only_beyond_the_threshold_of_every_different_rival():
-    from harvester.diagnosis.confirm import ConfirmSettings, mark_ties
+    from harvester.diagnosis.name.confirm import ConfirmSettings, mark_ties
     cs = ConfirmSettings()
     # a physically different rival 2 nats behind: a tie, both ways
     results = [_result("unmodelled_mode", 20.0), _result("inertia_error", 18.0)]
@@ -310,7 +310,7 @@ def test_an_effect_is_named_alone_only_beyond_the_threshold_of_every_different_r
 
 
 def test_separating_experiments_are_the_recordings_own_scaled_and_a_sweep():
-    from harvester.diagnosis.separate import proposed_experiments
+    from harvester.diagnosis.name.separate import proposed_experiments
     u = np.random.default_rng(0).standard_normal(2048)
     exps = proposed_experiments(u, 1 / 256.0, 16.0)
     assert [e.name for e in exps] == ["twice_amplitude", "half_amplitude", "sine_sweep"]
@@ -321,7 +321,7 @@ def test_separating_experiments_are_the_recordings_own_scaled_and_a_sweep():
 
 
 def test_a_posterior_is_piled_against_a_bound_only_when_the_bound_cuts_it():
-    from harvester.diagnosis.detect import at_prior_edge
+    from harvester.diagnosis.detect.scores import at_prior_edge
     from harvester.inference.priors import PriorSpec
 
     rng = np.random.default_rng(0)
@@ -338,7 +338,7 @@ def test_a_posterior_is_piled_against_a_bound_only_when_the_bound_cuts_it():
 
 
 def test_chains_are_enlarged_only_where_a_decision_lies_within_their_range():
-    from harvester.diagnosis.confirm import _straddles
+    from harvester.diagnosis.name.confirm import _straddles
 
     # acceptance at baseline + 3; a tie boundary at best - 3 and best + 3
     decisions = (103.0, 497.0, 503.0)
@@ -355,10 +355,10 @@ def test_chains_are_enlarged_only_where_a_decision_lies_within_their_range():
 def concealed_mode():
     """A 16 s record with a secondary mode at half the noise RMS, its MAP baseline as the
     nested fit (the evidence stand-in: its likelihood at the posterior mean), the scales."""
-    from harvester.diagnosis.fits import ModelFit
+    from harvester.diagnosis.name.fits import ModelFit
     from harvester.diagnosis.run import default_priors
-    from harvester.diagnosis.screen import max_loglike
-    from harvester.diagnosis.signatures import motion_scale
+    from harvester.diagnosis.name.screen import max_loglike
+    from harvester.diagnosis.detect.signatures import motion_scale
     from harvester.inference.priors import priors_for
     from harvester.model.structures import structure
 
@@ -374,7 +374,7 @@ def concealed_mode():
 
 
 def test_max_loglike_is_the_likelihood_at_its_best_sigma(concealed_mode):
-    from harvester.diagnosis.screen import max_loglike
+    from harvester.diagnosis.name.screen import max_loglike
     _, _, nested, _, _ = concealed_mode
     theta = nested.samples.mean(axis=0)
     best = max_loglike(nested.problem, theta)
@@ -385,7 +385,7 @@ def test_max_loglike_is_the_likelihood_at_its_best_sigma(concealed_mode):
 
 
 def test_the_screen_puts_a_concealed_mode_first_at_its_frequency(concealed_mode):
-    from harvester.diagnosis.screen import screen
+    from harvester.diagnosis.name.screen import screen
     sc, det, nested, specs, scale = concealed_mode
     out = screen(nested, ["inertia_error", "cubic_stiffness", "unmodelled_mode"], specs, scale,
                  det)
@@ -401,8 +401,8 @@ def test_the_screen_puts_a_concealed_mode_first_at_its_frequency(concealed_mode)
 def test_a_modes_fit_starts_at_its_scanned_shape_inside_the_prior(concealed_mode):
     # an unfiltered record's band puts the frequency prior's lower end above the scan's first
     # value: the scan keeps what lies inside, and the fit starts at the whole scanned shape
-    from harvester.diagnosis.fits import candidate_priors, scan_factor
-    from harvester.diagnosis.screen import scanned_start
+    from harvester.diagnosis.name.fits import candidate_priors, scan_factor
+    from harvester.diagnosis.name.screen import scanned_start
     sc, det, nested, specs, scale = concealed_mode
     priors = {**candidate_priors("unmodelled_mode", scale, nested.problem.known), **specs,
               "f_mode": PriorSpec.log_uniform("f_mode", 2.0, 80.0, "Hz")}
@@ -423,12 +423,12 @@ def test_a_modes_fit_starts_at_its_scanned_shape_inside_the_prior(concealed_mode
 
 
 def _screened(effect, bound, failed=False):
-    from harvester.diagnosis.screen import Screened
+    from harvester.diagnosis.name.screen import Screened
     return Screened(effect, (), np.zeros(1), 0.0, bound, bound + 30.0, failed, 0, 0.0)
 
 
 def test_a_candidate_is_sampled_unless_its_evidence_bound_rules_it_out():
-    from harvester.diagnosis.confirm import ConfirmSettings, skip_reason
+    from harvester.diagnosis.name.confirm import ConfirmSettings, skip_reason
     cs = ConfirmSettings()  # acceptance at log(20) = 3.0 nats plus two standard errors
     assert skip_reason(None, [], cs, 3) is None                      # not screened: sampled
     assert skip_reason(_screened("end_stop", 2.0), [], cs, 3) is not None   # cannot pass
@@ -448,7 +448,7 @@ def test_acceptance_shares_alpha_among_the_candidates_the_round_could_name():
     # the per-candidate threshold 3.3, in a round that could have named any of 11 effects
     from types import SimpleNamespace
 
-    from harvester.diagnosis.confirm import ConfirmSettings, judge, skip_reason
+    from harvester.diagnosis.name.confirm import ConfirmSettings, judge, skip_reason
     from harvester.inference.priors import PriorSpec
 
     one, family = ConfirmSettings(), ConfirmSettings(family=11)
@@ -476,7 +476,7 @@ def test_a_candidate_piled_where_it_stands_for_another_term_brings_that_term_in(
     # piled at its lower bound, where the law is Coulomb's
     from types import SimpleNamespace
 
-    from harvester.diagnosis.confirm import limit_candidates
+    from harvester.diagnosis.name.confirm import limit_candidates
     from harvester.model.structures import structure
 
     tanh = structure("tanh")
@@ -492,7 +492,7 @@ def test_a_candidate_piled_where_it_stands_for_another_term_brings_that_term_in(
     assert limit_candidates("unmodelled_mode", mode.at_prior_edge, tanh,
                             ["unmodelled_mode"]) == []
     # and the term it becomes is that term's physics, not a rival explanation of it
-    from harvester.diagnosis.confirm import becomes
+    from harvester.diagnosis.name.confirm import becomes
 
     assert becomes(piled, "coulomb_friction") and not becomes(piled, "cubic_stiffness")
     assert not becomes(other_side, "coulomb_friction")
@@ -500,7 +500,7 @@ def test_a_candidate_piled_where_it_stands_for_another_term_brings_that_term_in(
 
 
 def test_a_trusted_importance_estimate_rules_out_what_the_bound_cannot():
-    from harvester.diagnosis.confirm import ConfirmSettings, skip_reason
+    from harvester.diagnosis.name.confirm import ConfirmSettings, skip_reason
     from harvester.inference.importance import ImportanceEstimate
     cs = ConfirmSettings()
     mode = _screened("unmodelled_mode", 7.9)  # the bound alone would sample it
@@ -514,7 +514,7 @@ def test_a_trusted_importance_estimate_rules_out_what_the_bound_cannot():
 
 
 def test_a_failed_fit_is_sampled_only_where_a_trusted_importance_estimate_leaves_it_open():
-    from harvester.diagnosis.confirm import ConfirmSettings, skip_reason
+    from harvester.diagnosis.name.confirm import ConfirmSettings, skip_reason
     from harvester.inference.importance import ImportanceEstimate
     cs = ConfirmSettings()
     stop = _screened("backlash", -300.0, failed=True)  # its bound means nothing
@@ -566,7 +566,7 @@ def test_map_solves_from_several_starts_keep_the_best_end() -> None:
     """``fit_map(solves=k)`` runs least squares from the k best starts and keeps the best end:
     the best start (a = -1.0, SSE 0.36) lies in the worse basin, the second (a = 0.5, SSE
     0.585) in the better one; one solve stays at a = -1, two reach a = 1."""
-    from harvester.diagnosis.baseline import fit_map
+    from harvester.inference.map_fit import fit_map
     priors = {"a": PriorSpec("a", 0.0, 2.0, "-", lower=-np.inf)}
     starts = np.array([[-1.0], [0.5]])
     one = fit_map(_TwoBasins(), priors, n_starts=0, start=starts, solves=1).theta[0]
@@ -624,8 +624,8 @@ def test_a_map_on_a_bound_is_reported_only_where_the_posterior_must_pile_there()
     the same bound but the posterior spreads over the prior: not reported, and the exact
     posterior does not pile. b, which the data barely see, drifts to a bound without a slope:
     never reported. A level inside its prior is not on a bound."""
-    from harvester.diagnosis.baseline import PILE_NATS, bound_pull, fit_map
-    from harvester.diagnosis.detect import EDGE_SHARE, at_prior_edge
+    from harvester.inference.map_fit import PILE_NATS, bound_pull, fit_map
+    from harvester.diagnosis.detect.scores import EDGE_SHARE, at_prior_edge
     priors = {"a": PriorSpec.log_uniform("a", 0.1, 1.0, "-"),
               "b": PriorSpec.log_uniform("b", 0.1, 1.0, "-")}
     for truth, noise, n, piles in ((2.0, 0.1, 200, True), (2.0, 3.0, 5, False)):
@@ -650,7 +650,7 @@ def test_a_candidate_pulled_against_a_bound_is_sampled_last_and_only_to_tie() ->
     """A candidate whose best fit lies on a bound its posterior must pile against cannot be
     named (``judge`` does not trust it): it is sampled after the others, and only where a
     candidate accepted before it leaves a tie to make."""
-    from harvester.diagnosis.confirm import ConfirmSettings, sampling_order, skip_reason
+    from harvester.diagnosis.name.confirm import ConfirmSettings, sampling_order, skip_reason
     cs = ConfirmSettings()
     mode, asym, cubic = (_screened("unmodelled_mode", 167.0), _screened("asymmetric_friction",
                                                                          93.0),
@@ -677,10 +677,10 @@ def test_draws_of_a_trusted_importance_estimate_follow_the_exact_posterior() -> 
     exact posterior's do, and their mean and sd of ln a match the exact ones."""
     from types import SimpleNamespace
 
-    from harvester.diagnosis.baseline import fit_map
-    from harvester.diagnosis.confirm import judged_by_importance
-    from harvester.diagnosis.detect import at_prior_edge
-    from harvester.diagnosis.screen import Screened, importance_evidence
+    from harvester.inference.map_fit import fit_map
+    from harvester.diagnosis.name.confirm import judged_by_importance
+    from harvester.diagnosis.detect.scores import at_prior_edge
+    from harvester.diagnosis.name.screen import Screened, importance_evidence
     specs = {"a": PriorSpec.log_uniform("a", 0.1, 1.0, "-"),
              "b": PriorSpec.log_uniform("b", 0.1, 1.0, "-"),
              "sigma": PriorSpec.log_uniform("sigma", 1e-3, 10.0, "-")}

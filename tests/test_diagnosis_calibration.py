@@ -102,11 +102,11 @@ def test_evidence_acceptance_on_forced_candidates_at_most_5_percent():
     reject) are sampled on every record and compared by bridge-sampling evidence, whose
     standard error sets a lower threshold than TMCMC's chain scatter did. Markov's bound
     (``confirm``) allows 5 %; at most one acceptance of the 16 comparisons passes."""
-    from harvester.diagnosis.baseline import baseline_state, chain_problem, fit_map
-    from harvester.diagnosis.confirm import ConfirmSettings, confirm, fit_structure
-    from harvester.diagnosis.detect import estimate_temper
+    from harvester.inference.map_fit import baseline_state, chain_problem, fit_map
+    from harvester.diagnosis.name.confirm import ConfirmSettings, confirm, fit_structure
+    from harvester.diagnosis.detect.scores import estimate_temper
     from harvester.diagnosis.run import default_priors
-    from harvester.diagnosis.signatures import motion_scale
+    from harvester.diagnosis.detect.signatures import motion_scale
     from harvester.inference.problems import make_problem
     from harvester.model.structures import structure
 
@@ -136,12 +136,12 @@ def test_the_screens_bound_holds_and_its_laplace_estimate_tracks_the_evidence():
     that the screen decides on (within 1 nat of Monte Carlo error), the Laplace estimate
     of the gain lies within 10 nats of it, and the importance-sampling estimate, where
     trusted, within its stated error plus the screen's slack (IMPORTANCE_SLACK)."""
-    from harvester.diagnosis.baseline import baseline_state, chain_problem, fit_map
-    from harvester.diagnosis.confirm import ConfirmSettings, candidate_fit, fit_structure
-    from harvester.diagnosis.detect import estimate_temper
+    from harvester.inference.map_fit import baseline_state, chain_problem, fit_map
+    from harvester.diagnosis.name.confirm import ConfirmSettings, candidate_fit, fit_structure
+    from harvester.diagnosis.detect.scores import estimate_temper
     from harvester.diagnosis.run import default_priors
-    from harvester.diagnosis.screen import IMPORTANCE_SLACK, screen
-    from harvester.diagnosis.signatures import motion_scale
+    from harvester.diagnosis.name.screen import IMPORTANCE_SLACK, screen
+    from harvester.diagnosis.detect.signatures import motion_scale
     from harvester.inference.problems import make_problem
     from harvester.model.structures import structure
 

@@ -7,14 +7,14 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from harvester.diagnosis.detect import DetectionSettings, data_estimate, prior_conflicts
-from harvester.diagnosis.rank import RankedCandidate, rivals, to_confirm
+from harvester.diagnosis.detect.scores import DetectionSettings, data_estimate, prior_conflicts
+from harvester.diagnosis.name.rank import RankedCandidate, rivals, to_confirm
 from harvester.inference.priors import PriorSpec
-from harvester.diagnosis.floor import Floor
+from harvester.diagnosis.detect.floor import Floor
 from harvester.diagnosis.run import decide_verdict
-from harvester.diagnosis.settings import DiagnosisSettings
-from harvester.diagnosis.verdict import FitJudgement
-from harvester.diagnosis.signatures import candidate_terms
+from harvester.diagnosis.prepare.settings import DiagnosisSettings
+from harvester.diagnosis.name.verdict import FitJudgement
+from harvester.diagnosis.detect.signatures import candidate_terms
 
 
 def test_verdict_needs_evidence_or_a_strong_unexplained_detection():
@@ -58,7 +58,7 @@ def test_every_alpha_of_the_settings_is_reachable_at_the_default_settings():
     """The smallest p-value each verdict's test can give at the default settings lies below
     its alpha: the detection's p-value at a statistic far out in the replicates' tail (the
     replicates' count is the default ``bootstrap``), the evidence's by construction."""
-    from harvester.diagnosis.tail import tail_p
+    from harvester.inference.tail import tail_p
 
     s = DiagnosisSettings()
     reps = np.max(np.random.default_rng(0).standard_normal((s.bootstrap, 40)) ** 2, axis=1)

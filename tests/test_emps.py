@@ -117,7 +117,7 @@ def test_map_fit_finds_the_published_friction(training) -> None:
     """The MAP that starts the study's TMCMC (``fit_map`` on the closed loop): its residuals
     are the likelihood's (same sums of squares), and on 8 s it lands within 10 % of the
     published Fc and Fv (20.4 N, 203.5 N s/m), from broad priors centred away from them."""
-    from harvester.diagnosis.baseline import fit_map
+    from harvester.inference.map_fit import fit_map
     rec = sliced(training, 8.0)
     p = emps.closed_loop_problem(rec, MODEL)
     th = published_theta(p)
@@ -192,7 +192,7 @@ def test_the_diagnosis_summary_page_of_the_emps_study(tmp_path) -> None:
     """``summary_doc``: the named term with its level beside the published one, every
     candidate but the baseline (read back from CSV, its empty term as NaN), both models on
     the unseen record; the page every diagnosis has renders it, figures with their lines."""
-    from harvester.diagnosis.summary_page import summary_page
+    from harvester.diagnosis.report.summary_page import summary_page
     evidence = pd.DataFrame({
         "model": ["viscous+coulomb_friction", "viscous+tanh_friction", "viscous"],
         "added_term": ["coulomb_friction", "tanh_friction", np.nan], "n_parameters": [4, 5, 3],

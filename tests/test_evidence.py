@@ -119,8 +119,8 @@ def test_the_diagnosis_evidence_agrees_with_tmcmc_and_is_more_precise():
     """On a tanh-device record, the bridge estimate from TMCMC's final population lies within
     TMCMC's own chain-to-chain scatter of its pooled estimate, and its stated error is
     smaller than that scatter."""
-    from harvester.diagnosis.baseline import chain_problem
-    from harvester.diagnosis.confirm import ConfirmSettings, fit_structure
+    from harvester.inference.map_fit import chain_problem
+    from harvester.diagnosis.name.confirm import ConfirmSettings, fit_structure
     from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
     from harvester.inference.problems import make_problem
     from harvester.inference.priors import PriorSpec

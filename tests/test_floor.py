@@ -1,4 +1,4 @@
-"""The recording's own noise floor (diagnosis.floor) against known noise levels."""
+"""The recording's own noise floor (diagnosis.detect.floor) against known noise levels."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from harvester.data.signals import lowpass
-from harvester.diagnosis.floor import input_period, output_floor, periodic_floor, quiet_floor
+from harvester.diagnosis.detect.floor import input_period, output_floor, periodic_floor, quiet_floor
 
 FS = 250.0
 

@@ -93,7 +93,7 @@ def test_a_named_mass_error_on_such_a_record_is_said_not_fixed():
     from types import SimpleNamespace
 
     from harvester.data.input_noise import SharedNoise
-    from harvester.diagnosis.run import mass_size_caveat
+    from harvester.diagnosis.size.estimate import mass_size_caveat
     shared = SimpleNamespace(shared_input_noise=SharedNoise(-1.0, 0.45, 240))
     own = SimpleNamespace(shared_input_noise=None)
     tie = SimpleNamespace(effects=["inertia_error", "unmodelled_mode"])

@@ -1,4 +1,4 @@
-"""The missing force as a latent force (diagnosis.latent): the Matern state space, the terms'
+"""The missing force as a latent force (diagnosis.size.latent): the Matern state space, the terms'
 forces along a path (the library's laws), and the force recovered within its bands on records
 with a known added force (the library's simulator, and an integrator written here)."""
 
@@ -13,14 +13,14 @@ from scipy import signal
 import pandas as pd
 
 from latent_records import C_M, FS, linear_state, recording, rk4_record
-from harvester.diagnosis.baseline import ChainProblem, baseline_state
-from harvester.diagnosis.latent import latent_force, through_response
-from harvester.diagnosis.latent_views import binned, effect_force, views
-from harvester.diagnosis.shapes import describe
+from harvester.inference.map_fit import ChainProblem, baseline_state
+from harvester.diagnosis.size.latent import latent_force, through_response
+from harvester.diagnosis.size.views import binned, effect_force, views
+from harvester.diagnosis.size.shapes import describe
 from harvester.data.signals import butterworth_sos, lowpass
-from harvester.diagnosis.state_space import (discretise, filtered_noise, kalman_filter,
+from harvester.inference.state_space import (discretise, filtered_noise, kalman_filter,
                                              kalman_loglik, matern, rts_smoother)
-from harvester.diagnosis.term_forces import model_force
+from harvester.model.term_forces import model_force
 from harvester.inference.likelihood import DAQ_OVERSAMPLE
 from harvester.model.simulate import simulate
 from harvester.model.structures import Layout, structure

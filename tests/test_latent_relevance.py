@@ -1,5 +1,5 @@
-"""A named effect's size and relevance beside the latent force (diagnosis.relevance) and the
-one-call entry point (diagnosis.missing_force)."""
+"""A named effect's size and relevance beside the latent force (diagnosis.size.relevance) and the
+one-call entry point (diagnosis.size.missing_force)."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from latent_records import linear_state, recording, rk4_record
-from harvester.diagnosis.missing_force import NamedEffect, missing_force
-from harvester.diagnosis.relevance import RelevanceFloor
+from harvester.diagnosis.size.missing_force import NamedEffect, missing_force
+from harvester.diagnosis.size.relevance import RelevanceFloor
 from harvester.model.structures import structure
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning", "ignore::RuntimeWarning")
@@ -77,7 +77,7 @@ def test_a_residual_the_smoother_cannot_carry_is_not_called_no_missing_force():
     or with the noise fitted below its bound, the description stands."""
     from types import SimpleNamespace
 
-    from harvester.diagnosis.verdict import Conclusion, FitJudgement, headline, latent_unread
+    from harvester.diagnosis.name.verdict import Conclusion, FitJudgement, headline, latent_unread
     lf = SimpleNamespace(noise_sd=2.8e-4, baseline_noise_sd=2.8e-4, force=np.full(50, 0.1),
                          sd=np.full(50, 0.2))
     missing = SimpleNamespace(latent=lf, sizes=[], description=SimpleNamespace(
@@ -104,8 +104,8 @@ def test_one_named_effect_is_sized_by_its_own_force_in_the_headline():
     together keep the force beyond the baseline's."""
     from types import SimpleNamespace
 
-    from harvester.diagnosis.relevance import EffectSize, OwnForce, RelevanceFloor
-    from harvester.diagnosis.verdict import _named
+    from harvester.diagnosis.size.relevance import EffectSize, OwnForce, RelevanceFloor
+    from harvester.diagnosis.name.verdict import _named
     own = OwnForce((0.189, 0.128, 0.202), (0.001, -0.01, 0.01), (0.189, 0.128, 0.202), False)
     size = EffectSize("end_stop", 9.97, 3.71, 0.0, None, None, False, RelevanceFloor(),
                       own=own, drive_rms_N=9.97 / 3.71)
@@ -138,7 +138,7 @@ def test_an_own_forces_share_of_the_drive_is_over_its_own_span():
     record after the lead-in), while the force along the states keeps the window's."""
     from types import SimpleNamespace
 
-    from harvester.diagnosis.relevance import (EffectSize, OwnForce, RelevanceFloor, drive_rms,
+    from harvester.diagnosis.size.relevance import (EffectSize, OwnForce, RelevanceFloor, drive_rms,
                                                effect_size)
     window = np.full(100, 2.0)
     from harvester.data.units import SI

@@ -1,4 +1,4 @@
-"""The missing force's shape (diagnosis.shapes): records made here (``latent_records``, outside
+"""The missing force's shape (diagnosis.size.shapes): records made here (``latent_records``, outside
 the library) with forces of known shape get that shape, its period, frequency or trend within
 10 %."""
 
@@ -13,8 +13,8 @@ import pytest
 from scipy import optimize
 
 from latent_records import FS, LOWPASS_HZ, linear_state, recording, rk4_record
-from harvester.diagnosis.latent import latent_force
-from harvester.diagnosis.shapes import describe, library_terms
+from harvester.diagnosis.size.latent import latent_force
+from harvester.diagnosis.size.shapes import describe, library_terms
 from harvester.model.terms import TERMS, is_friction
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning", "ignore::RuntimeWarning")
@@ -116,7 +116,7 @@ def _frame_state(load: str, fit_damping: bool = False):
     from scipy.signal import savgol_filter
 
     from harvester.data.signals import lowpass
-    from harvester.diagnosis.baseline import BaselineState, ChainProblem
+    from harvester.inference.map_fit import BaselineState, ChainProblem
     from harvester.inference.likelihood import DAQ_OVERSAMPLE
     from harvester.model.structures import structure
 
@@ -166,7 +166,7 @@ def test_the_frames_friction_is_seen_beyond_its_noise_floor_under_a_fitted_basel
     (stick and slip, sliding at 1.23 N, 100 %). On this conversion (a 16 Hz band at 250 Hz)
     every 7th sample with white noise reads the same; on the study's (8 Hz at 143 Hz, every
     12th) it read nothing (docs/latent-force.md)."""
-    from harvester.diagnosis.floor import output_floor
+    from harvester.diagnosis.detect.floor import output_floor
 
     rms = {}
     for load in ("250", "450"):
@@ -189,7 +189,7 @@ def _named_beside(force, improved, theta, term_name, seconds=12.0):
     """The missing force of ``force`` under the linear baseline, and the improved model
     (``improved`` at ``theta``) beside it: (description, its share as the shapes read
     theirs, the diagnosis's missing force with the effect's size)."""
-    from harvester.diagnosis.missing_force import NamedEffect, missing_force
+    from harvester.diagnosis.size.missing_force import NamedEffect, missing_force
     from harvester.model.structures import structure
     state = linear_state(recording(rk4_record(force, seconds), "rel_acc"))
     named = NamedEffect(term_name, structure(improved), np.asarray(theta, dtype=float))
@@ -203,11 +203,11 @@ def test_a_named_term_is_checked_against_the_missing_forces_shape():
     place explains almost none of it and is withheld (``verdict.withheld_names``). A force
     periodic in z (outside the library) withholds the same cubic spring, and its
     description stays in the verdict's place."""
-    from harvester.diagnosis.shapes import has_its_shape, library_terms
+    from harvester.diagnosis.size.shapes import has_its_shape, library_terms
     from types import SimpleNamespace
 
-    from harvester.diagnosis.settings import DiagnosisSettings
-    from harvester.diagnosis.verdict import Conclusion, FitJudgement, judge, withheld_names
+    from harvester.diagnosis.prepare.settings import DiagnosisSettings
+    from harvester.diagnosis.name.verdict import Conclusion, FitJudgement, judge, withheld_names
     coulomb = lambda z, v, t: 6.0 * np.tanh(v / 1e-3)  # noqa: E731
     desc, share, _ = _named_beside(coulomb, "linear+coulomb_friction", [60.0, 6.0],
                                    "coulomb_friction")
@@ -244,9 +244,9 @@ def test_an_adequate_verdict_says_when_the_missing_force_stands_out():
     out of its uncertainty, with its description; with none missing, no such note."""
     from types import SimpleNamespace
 
-    from harvester.diagnosis.missing_force import missing_force
-    from harvester.diagnosis.settings import DiagnosisSettings
-    from harvester.diagnosis.verdict import Conclusion, FitJudgement, judge
+    from harvester.diagnosis.size.missing_force import missing_force
+    from harvester.diagnosis.prepare.settings import DiagnosisSettings
+    from harvester.diagnosis.name.verdict import Conclusion, FitJudgement, judge
     found = Conclusion("adequate", [], [], False, [], None, False)
     detection = SimpleNamespace(p_value=0.3, significant=False, conflict=False)
     fit = FitJudgement(0.98, 0.14, "holdout", 1.0, None, None)
@@ -266,7 +266,7 @@ def test_a_force_within_its_uncertainty_checks_no_name():
     """No missing force (the baseline at the truth): nothing to check a name against, so a
     name is never withheld for it, and no shape claims a share of a force that is not
     there."""
-    from harvester.diagnosis.shapes import has_its_shape
+    from harvester.diagnosis.size.shapes import has_its_shape
     desc, share, _ = _named_beside(lambda z, v, t: 0.0 * z, "linear+cubic_stiffness",
                                    [60.0, 1e6], "cubic_stiffness")
     assert not desc.readable and has_its_shape(desc, ["cubic_stiffness"], share)
@@ -278,8 +278,8 @@ def test_a_named_terms_own_force_is_sized_with_its_interval():
     F ~ N(6, 0.15) N: the 95 % interval of its own force's RMS holds the truth's RMS along
     the true path (over the latent force's window), and tightens around a wrong level
     (F ~ N(4, 0.15)) without holding it."""
-    from harvester.diagnosis.latent_views import parameter_values
-    from harvester.diagnosis.relevance import term_force_rms
+    from harvester.diagnosis.size.views import parameter_values
+    from harvester.diagnosis.size.relevance import term_force_rms
     from harvester.model.structures import structure
     truth = rk4_record(lambda z, v, t: 6.0 * np.tanh(v / 1e-3), 12.0)
     state = linear_state(recording(truth, "rel_acc"))
@@ -297,7 +297,7 @@ def test_a_named_terms_own_force_is_sized_with_its_interval():
     assert parameter_values(improved, samples[0], {"M": 1.0})["F_coulomb"] == samples[0, 1]
     # the diagnosis's problem stops 0.5 s after its analysed window: given the whole
     # record's input, the span is the record's, as if the problem had held it all
-    from harvester.diagnosis.baseline import chain_problem
+    from harvester.inference.map_fit import chain_problem
     full = term_force_rms(state.problem, improved, samples, "coulomb_friction")
     cut = chain_problem(dataclasses.replace(state.problem, window=(state.problem.window[0],
                                                                    int(6.0 * FS))),
@@ -314,8 +314,8 @@ def test_several_named_terms_are_sized_together_from_the_fit_that_holds_them():
     """missing_force.together_force: a Coulomb law and a cubic spring at k_cubic = 0 named
     from one fit: their summed own force is the Coulomb law's alone; from two fits, or one
     term, nothing."""
-    from harvester.diagnosis.missing_force import NamedEffect, together_force
-    from harvester.diagnosis.relevance import term_force_rms
+    from harvester.diagnosis.size.missing_force import NamedEffect, together_force
+    from harvester.diagnosis.size.relevance import term_force_rms
     from harvester.model.structures import structure
     truth = rk4_record(lambda z, v, t: 6.0 * np.tanh(v / 1e-3), 8.0)
     state = linear_state(recording(truth, "rel_acc"))
@@ -337,7 +337,7 @@ def test_an_even_terms_mean_is_said_apart_on_an_acceleration_record():
     the mean along the true path; from z'' the mean is the term's form's (a constant force
     only moves the rest position), from z it is seen. The size sentence then gives the
     varying part first, and the headline reads it."""
-    from harvester.diagnosis.relevance import EffectSize, RelevanceFloor, term_force_rms
+    from harvester.diagnosis.size.relevance import EffectSize, RelevanceFloor, term_force_rms
     from harvester.model.structures import structure
     truth = rk4_record(lambda z, v, t: 0.8 * np.tanh(v / 0.02) ** 2, 12.0)
     improved = structure("linear+asymmetric_friction")
@@ -363,7 +363,7 @@ def test_an_even_terms_mean_is_said_apart_on_an_acceleration_record():
 def test_a_term_whose_strength_trades_against_the_baseline_is_said_on_a_ridge():
     """relevance.ridge: c_quad drawn along c_m + 0.02 c_quad = const (correlation about
     -0.99) is on a ridge with c_m; drawn independently it is not."""
-    from harvester.diagnosis.relevance import ridge
+    from harvester.diagnosis.size.relevance import ridge
     from harvester.model.structures import structure
     rng = np.random.default_rng(1)
     improved = structure("linear+quadratic_damping")
@@ -382,7 +382,7 @@ def test_shapes_of_the_slow_part_do_not_judge_a_name_from_an_acceleration_record
     a slow line, and is for a fast one."""
     from types import SimpleNamespace
 
-    from harvester.diagnosis.shapes import Shape, ShapeDescription, has_its_shape, slow_shapes
+    from harvester.diagnosis.size.shapes import Shape, ShapeDescription, has_its_shape, slow_shapes
     t = np.arange(0.0, 30.0, 1.0 / 256.0)
     device = {"k": 14000.0, "M": 10.0}  # f_n = 5.96 Hz
     slow = Shape("line", 0.4, {}, "", np.sin(2 * np.pi * 0.3 * t))
@@ -400,7 +400,7 @@ def test_shapes_of_the_slow_part_do_not_judge_a_name_from_an_acceleration_record
 def test_a_force_that_pushes_along_the_motion_is_not_called_friction():
     """-1.5 N sgn(z') (energy put in, as a drive that follows the velocity): the friction
     shapes fit a negative level and explain nothing; a friction level is positive."""
-    from harvester.diagnosis.shapes import passive
+    from harvester.diagnosis.size.shapes import passive
     state = linear_state(recording(rk4_record(lambda z, v, t: -1.5 * np.tanh(v / 1e-3), 12.0),
                                    "rel_acc"))
     desc = describe(latent_force(state, draws=40))
@@ -415,7 +415,7 @@ def _noisy_latent(level: float, n: int = 4000, draws: int = 100, seed: int = 0):
     """A latent force of Coulomb friction ``level`` (N) on a 1 Hz motion plus a posterior
     mean's shrunk noise (0.3 N), each sample's sd 1 N and its draws independent N(0, 1)
     about the mean (white posterior spread)."""
-    from harvester.diagnosis.latent import LatentForce
+    from harvester.diagnosis.size.latent import LatentForce
     rng = np.random.default_rng(seed)
     t = np.arange(n) * 0.01
     z = 1e-3 * np.sin(2 * np.pi * t + 0.3 * np.sin(0.7 * t))
@@ -434,7 +434,7 @@ def test_a_shape_can_stand_out_where_no_sample_does():
     the draws' spread along it (16.0, within the determined band and referred to its three
     coefficients), and is read; where the mean is the shrunk noise alone no shape stands out
     by half the threshold (the scanned shapes' best fit of it)."""
-    from harvester.diagnosis.shapes import SHAPE_SD, beyond_uncertainty, standing
+    from harvester.diagnosis.size.shapes import SHAPE_SD, beyond_uncertainty, standing
     lf = _noisy_latent(0.3)
     desc = describe(lf)
     assert not beyond_uncertainty(lf)
@@ -452,8 +452,8 @@ def test_a_lines_amplitude_is_the_forces_not_what_the_smoother_holds():
     """A 2 N line at 7 Hz that the posterior mean holds through a response W of gain 0.28
     there (an 11-tap moving average at 100 Hz): the line shape gives 2 N back, and
     ``response_gain`` is the moving average's own |W(f)|."""
-    from harvester.diagnosis.latent import through_response
-    from harvester.diagnosis.shapes import line, response_gain
+    from harvester.diagnosis.size.latent import through_response
+    from harvester.diagnosis.size.shapes import line, response_gain
     lf = _noisy_latent(0.0)
     h = np.full(11, 1.0 / 11.0)
     seen = through_response(2.0 * np.cos(2 * np.pi * 7.0 * lf.time), h)
@@ -475,7 +475,7 @@ def test_a_sign_law_is_scanned_through_the_band_the_force_was_read_in():
     the width that mimics the band's rounding (2.2 mm/s) and read 3.16 N with -198 N s/m of
     viscous damping, and the drift 9 % high (on the literature generator's friction-drift
     records, 20-27 %)."""
-    from harvester.diagnosis.shapes import drifting_friction, friction
+    from harvester.diagnosis.size.shapes import drifting_friction, friction
     lf = dataclasses.replace(_noisy_latent(0.0), band_hz=5.0)
     v, t = lf.rel_vel, lf.time
     for shape, truth in [(friction, 2.0 * np.tanh(v / 1e-4)),
@@ -501,7 +501,7 @@ def test_a_shapes_standing_on_noise_is_referred_to_its_coefficients():
     fit's constant per stick phase: 13.5 sd on an effect-free record with 77 phases).
     Referred to chi^2_k the standing is a half-normal deviate: over 400 noise records with
     k = 50 its 95th percentile is 2.21 (1.96 nominal), against a raw median of 7.09."""
-    from harvester.diagnosis.shapes import Shape, standing
+    from harvester.diagnosis.size.shapes import Shape, standing
     rng = np.random.default_rng(4)
     n, k = 2000, 50
     basis = np.linalg.qr(rng.standard_normal((n, k)))[0]
@@ -537,8 +537,8 @@ def test_the_missing_forces_shape_nominates_the_terms_never_tried():
     be read (none missing) nominates nothing."""
     from dataclasses import replace
 
-    from harvester.diagnosis.missing_force import missing_force
-    from harvester.diagnosis.verdict import Conclusion, nominated_terms
+    from harvester.diagnosis.size.missing_force import missing_force
+    from harvester.diagnosis.name.verdict import Conclusion, nominated_terms
     everything = tuple(TERMS)
     out = missing_force(linear_state(recording(rk4_record(lambda z, v, t: 2e6 * z**3, 12.0),
                                                "rel_disp")), draws=20)

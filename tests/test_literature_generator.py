@@ -466,10 +466,10 @@ def test_a_cogging_record_is_described_periodic_in_z_with_its_period(tmp_path):
     likelihood, over the analysed window) is periodic in z at the drawn period within 10 %
     (measured 6.78 mm for 6.78 mm). Seed 0's period (0.10 mm) lies below the displacement's
     uncertainty from z'' (0.11 mm) and is not seen."""
-    from harvester.diagnosis.analysis import prepare, start_baseline
-    from harvester.diagnosis.baseline import baseline_state
-    from harvester.diagnosis.missing_force import missing_force
-    from harvester.diagnosis.settings import DiagnosisSettings
+    from harvester.diagnosis.prepare.analysis import prepare, start_baseline
+    from harvester.inference.map_fit import baseline_state
+    from harvester.diagnosis.size.missing_force import missing_force
+    from harvester.diagnosis.prepare.settings import DiagnosisSettings
     from harvester.initial.recording import diagnosis_priors
 
     g = L.generate("cogging", 1 + 20260501, ratio=1.0, duration_s=40.0)

@@ -14,7 +14,8 @@ import yaml
 from harvester.study import paper
 from harvester.initial.damping import DampingSummary
 from harvester.initial.static_friction import StaticFrictionEstimate
-from harvester.inference.priors import PriorSpec, prior_moments, prior_table
+from harvester.inference.priors import PriorSpec, prior_moments
+from harvester.study.tables import prior_table
 from harvester.study.tables import (
     COLUMNS,
     SIMULATED_NOTE,

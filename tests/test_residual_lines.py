@@ -9,7 +9,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from harvester.diagnosis.lines import LINE_ALPHA, residual_line
+from harvester.diagnosis.size.lines import LINE_ALPHA, residual_line
 from test_latent_shapes import _noisy_latent
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning", "ignore::RuntimeWarning")
@@ -71,9 +71,9 @@ def test_a_sensor_line_on_a_recording_is_noted_by_the_diagnosis():
     from types import SimpleNamespace
 
     from latent_records import linear_state, recording, rk4_record
-    from harvester.diagnosis.missing_force import missing_force
-    from harvester.diagnosis.settings import DiagnosisSettings
-    from harvester.diagnosis.verdict import Conclusion, FitJudgement, judge
+    from harvester.diagnosis.size.missing_force import missing_force
+    from harvester.diagnosis.prepare.settings import DiagnosisSettings
+    from harvester.diagnosis.name.verdict import Conclusion, FitJudgement, judge
     found = Conclusion("adequate", [], [], False, [], None, False)
     detection = SimpleNamespace(p_value=0.3, significant=False, conflict=False)
     fit = FitJudgement(0.98, 0.14, "holdout", 1.0, None, None)

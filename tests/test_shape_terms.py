@@ -1,4 +1,4 @@
-"""The missing force's periodic shape fitted as a term of the model (diagnosis.shape_terms):
+"""The missing force's periodic shape fitted as a term of the model (diagnosis.size.shape_terms):
 records made here (``latent_records``, the force written outside the library) with a force
 periodic in z get its period within 10 %; without it nothing stands; a fitted shape that
 beats the named effects' model withholds their names and describes the force."""
@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from latent_records import FS, LOWPASS_HZ, linear_state, recording, rk4_record
-from harvester.diagnosis.shape_terms import (BEAT_NATS, STAND_NATS, ShapeTermFit,
+from harvester.diagnosis.size.shape_terms import (BEAT_NATS, STAND_NATS, ShapeTermFit,
                                              period_grid, shape_term_fit)
-from harvester.diagnosis.signatures import motion_scale
+from harvester.diagnosis.detect.signatures import motion_scale
 from harvester.model.priors import PriorSpec
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning", "ignore::RuntimeWarning")
@@ -28,9 +28,9 @@ def _quiet():
 def _fitted(force, seconds=10.0, peak=2.0):
     """The periodic shape fitted as a term to the tanh baseline (c_m, F_c, beta free) on a
     record of the linear device with ``force`` added, shaken at ``peak`` m/s^2."""
-    from harvester.diagnosis.baseline import (ChainProblem, baseline_state, chain_problem,
+    from harvester.inference.map_fit import (ChainProblem, baseline_state, chain_problem,
                                               fit_map)
-    from harvester.diagnosis.detect import estimate_temper
+    from harvester.diagnosis.detect.scores import estimate_temper
     from harvester.inference.likelihood import DAQ_OVERSAMPLE
     from harvester.model.structures import structure
     from harvester.synthetic.measured import TABLE1_KNOWN
@@ -98,9 +98,9 @@ def test_a_fitted_shape_that_beats_the_names_withholds_them():
     no force; within BEAT_NATS, the name stands."""
     from types import SimpleNamespace
 
-    from harvester.diagnosis.missing_force import missing_force
-    from harvester.diagnosis.settings import DiagnosisSettings
-    from harvester.diagnosis.verdict import Conclusion, FitJudgement, judge, withheld_names
+    from harvester.diagnosis.size.missing_force import missing_force
+    from harvester.diagnosis.prepare.settings import DiagnosisSettings
+    from harvester.diagnosis.name.verdict import Conclusion, FitJudgement, judge, withheld_names
     out = missing_force(linear_state(recording(rk4_record(lambda z, v, t: 0.0 * z, 12.0))),
                         draws=20)
     assert not out.description.readable

@@ -159,7 +159,8 @@ def test_a_term_the_ranking_left_out_is_nominated_by_the_missing_force(monkeypat
     stop it nominates and names the cubic spring, with a note saying why (``diagnosis.run``, ``verdict.nominated_terms``;
     cheap settings)."""
     from harvester.data.public import silverbox_benchmark
-    from harvester.diagnosis import DiagnosisSettings, diagnose, rounds
+    from harvester.diagnosis import DiagnosisSettings, diagnose
+    from harvester.diagnosis.name import rounds
     from harvester.initial.recording import diagnosis_priors
     monkeypatch.setattr(rounds, "to_confirm", lambda *args, **kwargs: [])
     monkeypatch.setattr(rounds, "rivals", lambda *args, **kwargs: [])

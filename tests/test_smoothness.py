@@ -1,4 +1,4 @@
-"""The check of a candidate's likelihood for jumps before TMCMC (diagnosis.smoothness) and
+"""The check of a candidate's likelihood for jumps before TMCMC (diagnosis.name.smoothness) and
 what the rounds do with a candidate that fails it (confirm.rough, rounds.rough_rivals)."""
 
 from __future__ import annotations
@@ -9,11 +9,11 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from harvester.diagnosis.baseline import PointFit
-from harvester.diagnosis.confirm import rough, rough_reason
-from harvester.diagnosis.rounds import rough_notes, rough_rivals
-from harvester.diagnosis.screen import Screened
-from harvester.diagnosis.smoothness import ROUGH_NATS, smoothness
+from harvester.inference.map_fit import PointFit
+from harvester.diagnosis.name.confirm import rough, rough_reason
+from harvester.diagnosis.name.rounds import rough_notes, rough_rivals
+from harvester.diagnosis.name.screen import Screened
+from harvester.diagnosis.name.smoothness import ROUGH_NATS, smoothness
 from harvester.inference.priors import PriorSpec
 
 SPECS = {"a": PriorSpec("a", 1.0, 1.0, "N"), "b": PriorSpec.log_normal("b", 2.0, 1.0, "m")}
@@ -150,7 +150,7 @@ def test_the_headline_names_the_candidates_that_could_not_be_sampled():
     """One rough candidate is said in the singular, several in the plural."""
     from dataclasses import replace
 
-    from harvester.diagnosis.verdict import Conclusion, FitJudgement, headline
+    from harvester.diagnosis.name.verdict import Conclusion, FitJudgement, headline
     found = Conclusion("missing_physics", [], [], True, [], None, True)
     fit = FitJudgement(0.9, 0.3, "holdout", 1.0, None, None)
     one = headline("missing_physics", replace(found, unsampled=["stribeck_friction"]), fit,

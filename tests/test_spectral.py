@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from harvester.diagnosis.spectral import Frame, Metric, Projector, noise_replicates
+from harvester.diagnosis.detect.spectral import Frame, Metric, Projector, noise_replicates
 
 
 def test_replicates_calibrate_a_low_frequency_score_with_an_estimated_spectrum():

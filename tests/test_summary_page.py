@@ -13,7 +13,7 @@ import pytest
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from harvester.diagnosis.summary_page import summary_page  # noqa: E402
+from harvester.diagnosis.report.summary_page import summary_page  # noqa: E402
 
 DOC = {
     "verdict": "missing_physics",

@@ -1,4 +1,4 @@
-"""The tail p-value (diagnosis.tail) against exact answers: the maximum of independent
+"""The tail p-value (inference.tail) against exact answers: the maximum of independent
 chi-square(1) scores, whose distribution is known in closed form."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from harvester.diagnosis.tail import gpd_sample, pwm_fit, rank_p, tail_p
+from harvester.inference.tail import gpd_sample, pwm_fit, rank_p, tail_p
 
 #: Squared scores per replicate (the detection's statistic is the largest of many).
 SCORES = 40

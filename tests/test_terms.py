@@ -85,7 +85,7 @@ def test_friction_laws_and_their_refinements_are_friction_and_nothing_else_is():
 
 
 def test_a_named_effect_is_said_with_its_kind_and_its_fitted_strength_in_its_unit():
-    from harvester.diagnosis.verdict import _level
+    from harvester.diagnosis.name.verdict import _level
 
     class Fit:
         def summary(self):
@@ -101,7 +101,7 @@ def test_a_named_effect_s_strength_comes_from_the_round_that_named_it():
     """A later round's tie fits a model that need not describe the named effect (on the frame
     at 450 g a tied cubic stiffness took F_hyst from 1.12 to 0.028 N): the strength shown is
     the named round's (Conclusion.named_fit), the improved fit only when none is kept."""
-    from harvester.diagnosis.verdict import Conclusion, Tie, _named
+    from harvester.diagnosis.name.verdict import Conclusion, Tie, _named
 
     class Fit:
         def __init__(self, f):

@@ -1,4 +1,4 @@
-"""What the friction acts on, when the sidecar does not say (``diagnosis.topology``): a
+"""What the friction acts on, when the sidecar does not say (``diagnosis.prepare.topology``): a
 frame-like device written here, friction on the velocity relative to the base or to the
 ground, recorded as laser displacements (base_disp -> rel_disp), must be given its own form."""
 
@@ -8,8 +8,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from harvester.data.signals import lowpass
-from harvester.diagnosis.settings import DiagnosisSettings
-from harvester.diagnosis.topology import choose_topology, friction_structure
+from harvester.diagnosis.prepare.settings import DiagnosisSettings
+from harvester.diagnosis.prepare.topology import choose_topology, friction_structure
 from harvester.initial.recording import diagnosis_priors
 
 FS, SECONDS, CUT = 250.0, 8.0, 20.0

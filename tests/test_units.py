@@ -72,7 +72,7 @@ def test_the_sidecar_reads_units_and_refuses_malformed_ones(tmp_path) -> None:
 def _latent(units: Units, n: int = 400) -> tuple:
     """A small latent force: Coulomb friction of 0.5 on a 1 Hz motion of 1e-3 (in the
     recording's units), the baseline's values SI-like; (LatentForce, force)."""
-    from harvester.diagnosis.latent import LatentForce
+    from harvester.diagnosis.size.latent import LatentForce
     t = np.arange(n) * 0.01
     z = 1e-3 * np.sin(2 * np.pi * t)
     v = 2e-3 * np.pi * np.cos(2 * np.pi * t)
@@ -88,7 +88,7 @@ def _latent(units: Units, n: int = 400) -> tuple:
 def test_shape_sentences_say_the_recordings_units() -> None:
     """The friction, periodic and loop shapes and the description: "V", not " N" or "mm",
     with volts; "N" and "mm" with SI, as before."""
-    from harvester.diagnosis import shapes
+    from harvester.diagnosis.size import shapes
     lf, f = _latent(VOLTS)
     for shape in (shapes.friction, shapes.periodic_in_z, shapes.odd_in_z, shapes.damping,
                   shapes.drift, shapes.loop, shapes.inertial):
@@ -110,8 +110,8 @@ def test_shape_sentences_say_the_recordings_units() -> None:
 def test_verdict_and_size_sentences_say_the_recordings_units() -> None:
     """A named effect's strength (its probe parameter's unit) and its size in the headline,
     and the relevance sentence, in volts; in N with SI."""
-    from harvester.diagnosis.relevance import EffectSize, RelevanceFloor
-    from harvester.diagnosis.verdict import _level, _named
+    from harvester.diagnosis.size.relevance import EffectSize, RelevanceFloor
+    from harvester.diagnosis.name.verdict import _level, _named
     fit = SimpleNamespace(summary=lambda: {"F_hyst": {"mean": 0.636, "sd": 0.0052}})
     assert _level("hysteresis", fit, VOLTS) == "hysteresis (friction, F_hyst 0.636 +- 0.0052 V)"
     assert _level("hysteresis", fit) == "hysteresis (friction, F_hyst 0.636 +- 0.0052 N)"
@@ -131,7 +131,7 @@ def test_units_reach_the_diagnosis_settings_and_the_prepared_sidecar() -> None:
     keeps a given sidecar's units and writes none for SI."""
     import yaml
 
-    from harvester.diagnosis.settings import DiagnosisSettings
+    from harvester.diagnosis.prepare.settings import DiagnosisSettings
     from harvester.groups import _sidecar_text
     assert DiagnosisSettings().units == SI
     cfg = DiagnosisSettings.from_config({"units": {"force": "V", "displacement": "V"}})
@@ -160,7 +160,7 @@ def test_the_silverbox_sidecar_says_volts(tmp_path) -> None:
 
 def test_the_missing_force_views_are_labelled_in_the_recordings_units() -> None:
     """latent_views.views: z in mm and F in N for SI; in V (no factor of 1e3) for volts."""
-    from harvester.diagnosis.latent_views import views
+    from harvester.diagnosis.size.views import views
     x = np.linspace(-1.0, 1.0, 100)
     lf = SimpleNamespace(rel_disp=x, rel_vel=x, time=np.arange(100.0), input=x, force=x**3,
                          draws=np.tile(x**3, (3, 1)), input_kind="force", units=SI)

@@ -4,7 +4,7 @@
 from pathlib import Path
 
 from harvester.data.fileio import atomic_path, read_json
-from harvester.diagnosis.summary_page import summary_page
+from harvester.diagnosis.report.summary_page import summary_page
 from harvester.groups import diagnose_model
 from harvester.runlog import rule_log
 

@@ -7,7 +7,7 @@ import pandas as pd
 
 from harvester import emps
 from harvester.data.fileio import atomic_path, read_json
-from harvester.diagnosis.summary_page import summary_page
+from harvester.diagnosis.report.summary_page import summary_page
 from harvester.runlog import rule_log
 from harvester.inference.posterior import read_posterior
 

@@ -5,7 +5,8 @@ from types import SimpleNamespace
 
 from harvester.data.fileio import atomic_path, read_json, write_json
 from harvester.initial.static_friction import StaticFrictionEstimate
-from harvester.inference.priors import prior_moments, prior_table
+from harvester.inference.priors import prior_moments
+from harvester.study.tables import prior_table
 from harvester.runlog import rule_log
 from harvester.model.structures import structure
 from harvester.study.tables import render_table, table1, table1_notes, table1_values

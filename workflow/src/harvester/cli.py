@@ -53,8 +53,6 @@ exit status: 0 done, 2 bad input (named: file, line or column, found, expected).
 
 #: Sampler defaults of the command line (the study's config: 1000 particles x 2 chains).
 CLI_TMCMC = {"particles": 500, "chains": 2, "mcmc_steps": 3, "target_accept": 0.25}
-DIAGNOSE_NEEDS = ("harvester diagnose (with a base input eq. (1) fixes only ratios to a "
-                  "mass: at least one of M, m, k must be known; the others are identified)")
 
 _log_to_file = False
 
@@ -270,39 +268,25 @@ def _warn(text: str) -> None:
 
 def _read(path: Path, paper_device: bool, accept=None, known=None, known_from=None,
           for_model: bool = False):
-    """(checked recording, known parameters); the checks' warnings reported. ``for_model``:
-    a device whose sidecar says ``friction_on: ground`` is rewritten in absolute coordinates
-    (``harvester.data.kinds.on_ground``) after the checks, so that every command that fits or
-    predicts sees the same form."""
-    from harvester.data.daq import read_checked_recording
-    from harvester.data.sidecar import read_sidecar, resolve_known
+    """(checked recording, known parameters) by the library's one reader
+    (``data.device_recording``); its warnings and notes reported here."""
+    from harvester.data.device_recording import read_device_recording
     from harvester.study.paper import TABLE1_KNOWN
-    sidecar = read_sidecar(path)
-    kp = resolve_known(sidecar, TABLE1_KNOWN if paper_device else None,
-                       "the paper's Table 1 (--paper-device)")
-    values = kp.values if known is None else known
-    checked = read_checked_recording(path, values, known_from or kp.source, accept=accept)
-    for w in checked.warnings:
+    dev = read_device_recording(path, TABLE1_KNOWN if paper_device else None,
+                                "the paper's Table 1 (--paper-device)", accept=accept,
+                                known=known, known_from=known_from, for_model=for_model)
+    for w in dev.checked.warnings:
         _warn(str(w))
-    for note in kp.notes(sidecar):
+    for note in dev.notes:
         (_warn if note.startswith("ASSUMED") else log.info)(note)
-    if for_model and sidecar.friction_on == "ground":
-        from dataclasses import replace
-
-        from harvester.data.kinds import on_ground
-        from harvester.data.recording import recording_kinds
-        df, values, done = on_ground(checked.data, values, str(path))
-        for line in done:
-            log.info("%s", line)
-        checked = replace(checked, data=df, kinds=recording_kinds(df, path))
-        kp = replace(kp, values={k: v for k, v in kp.values.items() if k != "m"},
-                     given={k: v for k, v in kp.given.items() if k != "m"})
-    return checked, kp
+    for line in dev.rewritten:
+        log.info("%s", line)
+    return dev.checked, dev.known
 
 
 def _lowpass(args: argparse.Namespace, checked) -> tuple[float | None, str]:
     """The zero-phase low-pass the recording went through (Hz or None) and where it is from."""
-    from harvester.diagnosis.spectral import recording_lowpass
+    from harvester.diagnosis.detect.spectral import recording_lowpass
     if args.filtered_at is not None:
         return (args.filtered_at or None), "--filtered-at"
     if checked.sidecar.filtered_at_hz is not None:
@@ -343,6 +327,12 @@ def _quiet_pymc() -> None:
     """PyMC sets its logger to INFO when imported: quiet it once it is."""
     import pymc  # noqa: F401
     logging.getLogger("pymc").setLevel(logging.ERROR)
+
+
+def _fit_figure(args: argparse.Namespace, note: str):
+    """The posterior's pair figure for ``fit_recording``, or None with --no-figures."""
+    from harvester.plots.posterior import fit_pair_figure
+    return None if args.no_figures else fit_pair_figure(note)
 
 
 def _settings(args: argparse.Namespace):
@@ -416,8 +406,8 @@ def identify_command(args: argparse.Namespace) -> int:
     record = {**_record("identify", args, checked, kp),
               **_fit_record(problem, priors, notes, settings)}
     with atomic_directory(args.out, _key(args)) as stage:
-        fit = fit_recording(problem, priors, settings, stage, not args.no_figures,
-                            f"recording: {args.recording.name}")
+        fit = fit_recording(problem, priors, settings, stage,
+                            _fit_figure(args, f"recording: {args.recording.name}"))
         write_json({**record, "evidence": fit.evidence}, stage / "run.json")
     ev = fit.evidence
     print(f"{args.model}: log evidence {ev['log_evidence']:.2f}"
@@ -444,8 +434,8 @@ def compare_command(args: argparse.Namespace) -> int:
         for old in (stage / "models").glob("*") if (stage / "models").exists() else []:
             if old.name not in args.models:
                 shutil.rmtree(old)  # left by a killed run with other models
-        fits = {m: fit_recording(p, pr, settings, stage / "models" / m, not args.no_figures,
-                                 f"recording: {args.recording.name}")
+        fits = {m: fit_recording(p, pr, settings, stage / "models" / m,
+                                 _fit_figure(args, f"recording: {args.recording.name}"))
                 for m, (p, pr, _) in prepared.items()}
         table = evidence_table({m: f.evidence for m, f in fits.items()})
         table.to_csv(stage / "evidence.csv", index=False, float_format="%.6g")
@@ -462,6 +452,7 @@ def predict_command(args: argparse.Namespace) -> int:
     from harvester.inference.posterior import read_posterior
     from harvester.inference.unseen import (posterior_structure, predict_unseen,
                                             unseen_problem, write_prediction)
+    from harvester.plots.predictive import prediction_figure
     check_output_dir(args.out, inputs=(args.recording, args.posterior))
     if not args.posterior.is_file():
         raise DataError(args.posterior, "posterior not found (expected posterior.nc written by "
@@ -483,8 +474,8 @@ def predict_command(args: argparse.Namespace) -> int:
               "model": problem.structure.name, "known": problem.known}
     with atomic_directory(args.out, _key(args, Path(args.posterior))) as stage:
         pred = predict_unseen(problem, idata, args.samples, args.seed, args.lead_in)
-        files = write_prediction(pred, stage, not args.no_figures,
-                                 f"recording: {args.recording.name}")
+        files = write_prediction(pred, stage, None if args.no_figures else
+                                 prediction_figure(f"recording: {args.recording.name}"))
         write_json({**record, "metrics": pred.metrics, "files": files}, stage / "run.json")
     m = pred.metrics
     print(f"{m['model']} on {args.recording.name}: NRMSE {m['nrmse']:.3f}, outside +-3 sd "
@@ -492,111 +483,33 @@ def predict_command(args: argparse.Namespace) -> int:
     return 0
 
 
-def _diagnosis_settings(args: argparse.Namespace, lowpass: float | None, units=None):
-    """The command's DiagnosisSettings; ``units``: the sidecar's (None: N and m)."""
-    from harvester.data.units import SI
+def _diagnosis_settings(args: argparse.Namespace):
+    """The command's DiagnosisSettings (the low-pass the recording went through:
+    --filtered-at; the sidecar's and the units are the library's, ``diagnosis_input``)."""
     from harvester.diagnosis import DiagnosisSettings
     _quiet_pymc()
     overrides = {k: v for k, v in {"particles": args.particles, "rounds": args.rounds,
                                    "top": args.top}.items() if v is not None}
     if args.candidates:
         overrides["candidates"] = tuple(args.candidates)
-    overrides.update(chains=args.chains, seed=args.seed, lowpass_hz=lowpass,
-                     filter_order=args.filter_order, figures=not args.no_figures,
-                     units=units or SI)
+    overrides.update(chains=args.chains, seed=args.seed, lowpass_hz=args.filtered_at,
+                     filter_order=args.filter_order, figures=not args.no_figures)
     return DiagnosisSettings.fast(**overrides) if args.fast else DiagnosisSettings(**overrides)
-
-
-def _diagnosis_inputs(args: argparse.Namespace):
-    """(recording, validation, lowpass, known, sidecar priors, warnings and notes)."""
-    from harvester.data.kinds import INPUTS, OUTPUTS, input_kind
-    from harvester.data.recording import Accepted
-    from harvester.data.signals import filter_recording
-    accept = Accepted(tuple(INPUTS), tuple(OUTPUTS), "harvester diagnose",
-                      "time, one input and one output column")  # every kind
-    checked, kp = _read(args.recording, args.paper_device, accept, for_model=True)
-    if not input_kind(checked.kinds.input_kind).force_input and \
-            not {"M", "m", "k"} & set(kp.values):  # eq. (1) cannot fix the scale
-        kp.require(("M", "m", "k"), DIAGNOSE_NEEDS, checked.sidecar)
-    # 0 (--filtered-at 0, a sidecar's filtered_at_hz: 0): none, and the diagnosis looks for none
-    df, lowpass = checked.data, (args.filtered_at if args.filtered_at is not None
-                                 else checked.sidecar.filtered_at_hz)
-    notes = [str(w) for w in checked.warnings] + kp.notes(checked.sidecar)
-    validation = None
-    if args.validation is not None:
-        vc, _ = _read(args.validation, args.paper_device, accept, kp.values, kp.source,
-                      for_model=True)
-        validation = vc.data
-        notes += [str(w) for w in vc.warnings]
-    if args.lowpass is not None:
-        if not 0 < args.lowpass < 0.5 / checked.dt:
-            raise DataError(args.recording, f"--lowpass {args.lowpass} Hz must lie in (0, "
-                            f"{0.5 / checked.dt:g}) Hz")
-        output = (checked.kinds.output_kind,)  # the output alone, as the option says
-        df = filter_recording(df, args.lowpass, args.filter_order, str(args.recording), output)
-        if validation is not None:
-            validation = filter_recording(validation, args.lowpass, args.filter_order,
-                                          str(args.validation), output)
-        lowpass = args.lowpass
-    if checked.sidecar.friction_on == "ground":  # rewritten by _read
-        notes.append(f"{args.recording}: friction on the ground (sidecar friction_on): "
-                     "driven by the force k y with the output x = rel_disp + base_disp "
-                     "(harvester.data.kinds.on_ground)")
-    return df, validation, lowpass, kp.values, checked.sidecar, notes
-
-
-def _friction_form(args: argparse.Namespace, df, validation, known, sidecar, settings):
-    """(recording, validation, known, notes) in the form the device's friction acts in where
-    the sidecar does not say and both forms can be compared (``diagnosis.topology``): the
-    recording as it is, or rewritten with its friction on the ground (``data.kinds.on_ground``).
-    """
-    from harvester.data.kinds import on_ground
-    from harvester.diagnosis.topology import choose_topology, comparable
-    from harvester.initial.recording import diagnosis_priors
-    source = str(args.recording)
-    if sidecar.friction_on is not None or not comparable(df, known, source):
-        return df, validation, known, []
-
-    def priors_of(d, k):
-        return diagnosis_priors(d, args.baseline, k, sidecar.priors,
-                                settings.lowpass_hz or None, source)[0]
-    choice = choose_topology(df, known, args.baseline, priors_of, settings, source)
-    notes = [choice.sentence(source)]
-    if choice.chosen == "ground":
-        if validation is not None:
-            validation = on_ground(validation, known, str(args.validation))[0]
-        df, known, done = on_ground(df, known, source)
-        notes += done
-    return df, validation, known, notes
 
 
 def diagnose_command(args: argparse.Namespace) -> int:
     from harvester.data.fileio import atomic_directory, check_output_dir
-    from harvester.diagnosis import check_recording, diagnose, write
-    from harvester.initial.recording import diagnosis_priors
+    from harvester.diagnosis import diagnose_recording, write
+    from harvester.study.paper import TABLE1_KNOWN
 
     check_output_dir(args.out, inputs=tuple(p for p in (args.recording, args.validation) if p))
-    df, validation, lowpass, known, sidecar, notes = _diagnosis_inputs(args)
-    settings = _diagnosis_settings(args, lowpass, sidecar.units)
-    check_recording(df, str(args.recording), settings.lead_in_s,
-                    0.0 if validation is not None else settings.holdout_fraction)
-    df, validation, known, form_notes = _friction_form(args, df, validation, known, sidecar,
-                                                       settings)
-    notes += form_notes
-    try:
-        priors, prior_notes = diagnosis_priors(df, args.baseline, known, sidecar.priors,
-                                               settings.lowpass_hz or None, str(args.recording))
-    except KeyError as err:  # a prior in the sidecar for a parameter the library lacks
-        raise DataError(sidecar.path, str(err.args[0])) from None
-    except ValueError as err:  # the FRF fit of unknown M, m, k failed
-        raise DataError(args.recording, f"the priors of the unknown device parameters: "
-                        f"{err}") from None
-    notes += prior_notes
     key = _key(args, Path(args.validation) if args.validation else None)
     with atomic_directory(args.out, key) as stage:
-        diag = diagnose(df, args.baseline, known, priors, validation=validation,
-                        settings=settings, source=str(args.recording))
-        diag.notes[:0] = notes
+        diag = diagnose_recording(
+            args.recording, args.baseline, validation=args.validation,
+            settings=_diagnosis_settings(args), lowpass_output_hz=args.lowpass,
+            defaults=TABLE1_KNOWN if args.paper_device else None,
+            defaults_from="the paper's Table 1 (--paper-device)")
         write(diag, stage)
     print(f"{diag.headline} -> {args.out / 'diagnosis.json'}")
     return 0

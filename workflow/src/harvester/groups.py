@@ -113,7 +113,7 @@ def _sidecar_text(known: Mapping[str, float], priors: Mapping, filtered_at: floa
 def _cutoff(first, given, sidecar, lowpass_hz: float | None) -> tuple[float | None, str]:
     """(low-pass the recording went through, Hz or None; where that is from): the workflow's,
     unless the sidecar's is lower; else the sidecar's; else found in the output's spectrum."""
-    from harvester.diagnosis.spectral import recording_lowpass
+    from harvester.diagnosis.detect.spectral import recording_lowpass
     if lowpass_hz:
         if given.filtered_at_hz and given.filtered_at_hz < float(lowpass_hz):
             return given.filtered_at_hz, "the sidecar (below the workflow's low-pass)"
@@ -139,13 +139,13 @@ def prepare_recording(source: str | Path, sidecar: str | Path | None, out_csv: s
     The sidecar written is the sheet's (``sidecar``, or none) with ``filtered_at_hz``: the
     workflow's own low-pass (``lowpass_hz``, applied before: rule ``lowpass``), else the
     sheet sidecar's, else the cut-off found from the output's spectrum
-    (``diagnosis.spectral.recording_lowpass``), else none; every later step reads it from there,
+    (``diagnosis.detect.spectral.recording_lowpass``), else none; every later step reads it from there,
     and the sheet sidecar's ``units`` where not N and m (the diagnosis's labels).
     Both files appear only when the checks pass (DataError naming the file otherwise). A
     sidecar's ``friction_on: ground`` rewrites the recording in absolute coordinates
     (``data.kinds.on_ground``), so that every later step fits the device's own form; the
     workflow does not choose the form when the sidecar is silent (``harvester diagnose``
-    does: ``diagnosis.topology``).
+    does: ``diagnosis.prepare.topology``).
     """
     from harvester.data.daq import read_checked_recording, sha256
     from harvester.data.sidecar import Sidecar, sidecar_path
@@ -244,6 +244,7 @@ def identify_model(data: str | Path, priors_file: str | Path, model: str,
     from harvester.data.daq import read_checked_recording
     from harvester.inference.identify import TMCMCSettings
     from harvester.inference.recording_fit import fit_recording, recording_problem
+    from harvester.plots.posterior import fit_pair_figure
 
     known, priors = read_priors(priors_file)
     checked = read_checked_recording(data, known=known, known_from=str(priors_file))
@@ -253,7 +254,7 @@ def identify_model(data: str | Path, priors_file: str | Path, model: str,
                                 _window(settings, checked.sidecar.filtered_at_hz), str(data),
                                 HINT)
     return fit_recording(problem, priors, TMCMCSettings.from_config(settings["tmcmc"]),
-                         Path(out_dir), True, f"recording: {Path(data).name}")
+                         Path(out_dir), fit_pair_figure(f"recording: {Path(data).name}"))
 
 
 def evidence_table(models: Sequence[str], summaries: Sequence[str | Path]
@@ -287,6 +288,7 @@ def validate_model(posterior: str | Path, recording: str | Path, samples: int, s
     from harvester.inference.posterior import read_posterior
     from harvester.inference.unseen import (posterior_structure, predict_unseen,
                                             unseen_problem, write_prediction)
+    from harvester.plots.predictive import prediction_figure
     idata = read_posterior(posterior)
     _, known = posterior_structure(idata, str(posterior))
     checked = read_checked_recording(recording, known=known,
@@ -296,7 +298,8 @@ def validate_model(posterior: str | Path, recording: str | Path, samples: int, s
     problem = unseen_problem(idata, checked.data, str(posterior), str(recording))
     pred = predict_unseen(problem, idata, samples, seed, lead_in_s)
     pred.metrics["recording"] = Path(recording).stem
-    write_prediction(pred, Path(out_dir), True, f"unseen recording: {Path(recording).name}")
+    write_prediction(pred, Path(out_dir),
+                     prediction_figure(f"unseen recording: {Path(recording).name}"))
     return pred.metrics
 
 

@@ -16,7 +16,7 @@ friction_on           ``base`` or ``ground``: what the device's friction acts on
                       to the ground, as on the frame of Marino and Cicirello);
                       ``harvester.data.kinds.on_ground`` writes such a recording. Not
                       given: relative to the base, except where ``harvester diagnose``
-                      can compare both (``harvester.diagnosis.topology``)
+                      can compare both (``harvester.diagnosis.prepare.topology``)
 units                 ``{force: UNIT, displacement: UNIT}``: the units of a recording not
                       in N and m (a circuit's volts: ``{force: V, displacement: V}``);
                       only the diagnosis's labels follow them (``harvester.data.units``);

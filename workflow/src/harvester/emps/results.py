@@ -229,7 +229,7 @@ SUMMARY_FIGURES = {
 def summary_doc(comparison: pd.DataFrame, evidence: pd.DataFrame, named: Mapping,
                 validation: pd.DataFrame, baseline: str, extended: str) -> dict:
     """The EMPS study's diagnosis as the fields of a diagnosis.json that the summary page
-    reads (``diagnosis.summary_page``): the named term with its posterior and the published
+    reads (``diagnosis.report.summary_page``): the named term with its posterior and the published
     value, each candidate's evidence gain over the baseline, and the baseline and extended
     models on the unseen record (its position error over its RMS tracking error, the NRMSE
     of the part of the motion the controller leaves)."""

@@ -51,8 +51,8 @@ def _library(effect, ratio, seed, settings, rig_cfg, preprocess, csv_path, truth
 def literature_refit(made) -> float:
     """``information.refit_unabsorbed`` of a literature record (``GeneratedRecording``) over
     the default diagnosis's TMCMC window, with the tanh baseline."""
-    from harvester.diagnosis.analysis import analysis_window
-    from harvester.diagnosis.settings import DiagnosisSettings
+    from harvester.diagnosis.prepare.analysis import analysis_window
+    from harvester.diagnosis.prepare.settings import DiagnosisSettings
     from harvester.grid.information import refit_unabsorbed
     from harvester.synthetic.literature import LEAD_IN_S
 

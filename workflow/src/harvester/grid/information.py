@@ -10,7 +10,7 @@ noise-free record left a residual of 0.0047 m/s^2 RMS, against 0.0054 for the sa
 without the effect (5 % of the noise).
 
 :func:`refit_unabsorbed` measures it the way the diagnosis sees the record: the same model
-input (``diagnosis.analysis.model_input``), measurement chain and priors
+input (``diagnosis.prepare.analysis.model_input``), measurement chain and priors
 (``initial.recording.recording_priors``). The baseline's MAP is fitted over the TMCMC window
 to the recording as it is, and to the recording with the effect's contribution taken out.
 The result is the RMS that the effect adds to the refit residual, in quadrature, over the
@@ -54,9 +54,9 @@ def refit_residual_rms(recording: pd.DataFrame, rel_acc: np.ndarray, known: Mapp
     device's own: from prior draws alone, the refit of a noise-free literature record stopped
     at c_m = 4e-9 N s/m, F_c 0.30 N against the device's 0.50 and 0.78)."""
     from harvester.data.signals import uniform_step
-    from harvester.diagnosis.analysis import model_input
-    from harvester.diagnosis.baseline import chain_problem, fit_map
-    from harvester.diagnosis.detect import band_top
+    from harvester.diagnosis.prepare.analysis import model_input
+    from harvester.inference.map_fit import chain_problem, fit_map
+    from harvester.diagnosis.detect.scores import band_top
     from harvester.inference.problems import make_problem
     from harvester.initial.recording import recording_priors
 

@@ -18,11 +18,11 @@ On an effect-free scenario, a false alarm is a flagged verdict.
 Size (``named_size``). Where the truth gives the force the nominal device misses along the
 true path (``missing_force_rms_N``, the literature generator's), the first term named alone
 is checked against it: the RMS of its own force over its posterior, each sample along its
-own simulated path (median and 95 % interval; ``diagnosis.relevance.term_force_rms``), and
+own simulated path (median and 95 % interval; ``diagnosis.size.relevance.term_force_rms``), and
 whether that interval holds the truth; where the diagnosis says an acceleration record
 leaves the force's mean to the term's form, both about their means
 (``missing_force_varying_rms_N``); where several terms are named from one fit, their own
-forces summed (``diagnosis.missing_force.together_force``). The two are one quantity for an effect added to the
+forces summed (``diagnosis.size.missing_force.together_force``). The two are one quantity for an effect added to the
 device (a stop, a spring, a damper, a mass error); for a friction law with memory the truth
 is the law's departure from the sliding one, which a term beside a refitted sliding law need
 not equal.
@@ -40,7 +40,7 @@ scenario holding less than log(1/alpha) nats (the acceptance threshold before it
 margin: 3.0 at alpha = 0.05) cannot be named by an evidence test that keeps its false-alarm
 rate at alpha, whatever the method; it is counted as not ``nameable`` and the table gives the
 rate named among the nameable scenarios beside the plain rate. The diagnosis itself asks for
-log(N/alpha) (``diagnosis.confirm``: 5.4 nats among the tanh model's 11 candidates), so a
+log(N/alpha) (``diagnosis.name.confirm``: 5.4 nats among the tanh model's 11 candidates), so a
 scenario holding 3-5.4 nats counts as nameable and is missed: the rate is conservative. The
 bound is approximate: the
 nonlinear refit absorbs a little more than the linearised one (an inertia error of the medium
@@ -71,7 +71,7 @@ log = logging.getLogger("harvester.grid.scoring")
 ACCEPTED: dict[str, tuple[str, ...]] = {"coulomb_friction": ("tanh_friction",)}
 #: Label of the confusion matrix's column for scenarios the diagnosis passed.
 ADEQUATE = "adequate"
-#: Verdicts that say the baseline misses something (``diagnosis.verdict.decide_verdict``).
+#: Verdicts that say the baseline misses something (``diagnosis.name.verdict.decide_verdict``).
 FLAGGED = ("missing_physics", "inadequate")
 #: Label for "missing physics" without a named effect.
 UNNAMED = "unnamed"

@@ -92,12 +92,11 @@ def map_start(problem: Problem, priors: Mapping[str, PriorSpec], seed: int = 0
               ) -> Reference | None:
     """The reference a "map" start tempers from: half the particles at the model's MAP with
     its Laplace covariance widened, the other half from the prior (the diagnosis's start,
-    ``diagnosis.confirm.map_reference``). The tempering then skips the stages that walk from
+    ``inference.reference.map_reference``). The tempering then skips the stages that walk from
     the prior to the posterior (EMPS: 3 stages instead of 10, 0.2x the time); the evidence is
     still the model's, tempered from a normalised defensive mixture. None where the Laplace
     covariance is not usable (then from the prior)."""
-    # the MAP fit and its Laplace covariance live with the diagnosis, their first user
-    from harvester.diagnosis.baseline import fit_map
-    from harvester.diagnosis.confirm import map_reference
+    from harvester.inference.map_fit import fit_map
+    from harvester.inference.reference import map_reference
     used = priors_for(problem, priors)
     return map_reference(fit_map(problem, used, seed=seed), used)

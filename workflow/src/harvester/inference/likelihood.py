@@ -229,7 +229,7 @@ class Problem:
         """How the simulated output is sampled and filtered before it meets ``observed``."""
         return Acquisition(self.oversample, self.output_filter)
 
-    # What a MAP fit reads of a problem (``harvester.diagnosis.baseline.fit_map``; its
+    # What a MAP fit reads of a problem (``harvester.inference.map_fit.fit_map``; its
     # ChainProblem puts both sides through its own low-pass).
     @property
     def measured_chain(self) -> np.ndarray:

@@ -19,19 +19,12 @@ import pandas as pd
 
 from harvester.model.priors import REFERENCE_DEVICE, Z_QUANTILES, DeviceScale, PriorSpec
 from harvester.model.terms import BASE_PARAMETERS, TERMS
-from harvester.study import paper
 
-__all__ = ["PAPER_PRIORS", "PriorSpec", "default_prior", "prior_moments", "prior_spec",
-           "prior_table", "priors_for", "recording_scale"]
+__all__ = ["PriorSpec", "default_prior", "prior_moments", "prior_spec", "priors_for",
+           "recording_scale"]
 
 if TYPE_CHECKING:
     from harvester.inference.likelihood import Problem
-
-#: The paper's prior tables, by model structure.
-PAPER_PRIORS: dict[str, Mapping[str, tuple[float, float | None]]] = {
-    "linear": paper.TABLE2, "tanh": paper.TABLE4,
-}
-
 
 def _prior_mean(name: str, entry: Mapping[str, Any], table1: Mapping[str, float]) -> float:
     """Mean of one prior: ``entry['mean']`` or, with ``from: table1``, our Table 1 value."""
@@ -81,38 +74,6 @@ def prior_moments(config_priors: Mapping[str, Mapping[str, Any]],
     return {name: prior_spec(name, entry, table1) for name, entry in config_priors.items()}
 
 
-def _paper_priors_for(model_params: Sequence[str]) -> Mapping[str, tuple[float, float | None]]:
-    """The paper table whose parameters are exactly ``model_params`` (Table 2 or Table 4)."""
-    for table in PAPER_PRIORS.values():
-        if set(table) == set(model_params):
-            return table
-    return paper.TABLE4
-
-
-def prior_table(model_params: Sequence[str], specs: Mapping[str, PriorSpec],
-                paper_priors: Mapping[str, tuple[float, float | None]] | None = None
-                ) -> pd.DataFrame:
-    """Our priors beside the paper's (Table 2 or 4) for the parameters of one model.
-
-    Columns: parameter, mean, sd, unit, paper_mean, paper_sd (NaN where the paper gives
-    none, e.g. sigma's sd in Table 2). ``paper_priors`` defaults to the paper table with the
-    same parameter set (Table 2 for {c_m, sigma}, otherwise Table 4).
-    """
-    missing = [p for p in model_params if p not in specs]
-    if missing:
-        raise ValueError(f"no prior for {missing}; config priors has {sorted(specs)}")
-    reference = _paper_priors_for(model_params) if paper_priors is None else paper_priors
-    rows = []
-    for name in model_params:
-        spec = specs[name]
-        paper_mean, paper_sd = reference.get(name, (np.nan, np.nan))
-        rows.append({"parameter": name, "mean": spec.mean, "sd": spec.sd, "unit": spec.unit,
-                     "paper_mean": float(paper_mean),
-                     "paper_sd": np.nan if paper_sd is None else float(paper_sd)})
-    return pd.DataFrame(rows, columns=["parameter", "mean", "sd", "unit", "paper_mean",
-                                       "paper_sd"])
-
-
 def default_prior(name: str, device: DeviceScale = REFERENCE_DEVICE) -> PriorSpec:
     """The physics library's prior of a parameter on ``device`` (the paper's rig by default;
     used where the config gives none)."""
@@ -136,7 +97,7 @@ def recording_scale(df: pd.DataFrame, values: Mapping[str, float],
     force c_eq v by the power balance (N; the reference rig's where that cannot tell), the
     band's top f_high (Hz, SCALE_BAND_TOP) and M, m, k from ``values`` (known or fitted;
     NaN where absent): what the diagnosis takes from its baseline's simulated motion
-    (``harvester.diagnosis.signatures.motion_scale``), here without a model, for
+    (``harvester.diagnosis.detect.signatures.motion_scale``), here without a model, for
     ``harvester identify`` and ``compare`` on a device unlike the paper's rig (a circuit in
     volts: k_cubic's prior in k / z^2 is 1e5 times narrower than on the rig's scale).
 

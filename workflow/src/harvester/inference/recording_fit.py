@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import json
 import logging
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -27,7 +27,7 @@ from harvester.inference.identify import TMCMCSettings, identify
 from harvester.inference.problems import make_problem
 from harvester.inference.likelihood import Problem
 from harvester.inference.posterior import (adjusted_draws, interval_columns, log_evidence,
-                                          parameter_names, posterior_theta,
+                                          parameter_names,
                                           pooled_log_evidence)
 from harvester.inference.priors import PriorSpec
 
@@ -138,6 +138,11 @@ class Fit:
     evidence: dict
 
 
+#: Draws a fit's figure in a directory and returns its file name (the inference layer writes
+#: no figure itself: ``harvester.plots.posterior.fit_pair_figure``).
+FitFigure = Callable[[Fit, Path], str]
+
+
 def load_fit(directory: Path, problem: Problem, priors: dict[str, PriorSpec]) -> Fit | None:
     """A finished run in ``directory`` (evidence.json and posterior.nc), or None."""
     ev, nc = directory / "evidence.json", directory / "posterior.nc"
@@ -148,24 +153,24 @@ def load_fit(directory: Path, problem: Problem, priors: dict[str, PriorSpec]) ->
 
 
 def fit_recording(problem: Problem, priors: dict[str, PriorSpec], settings: TMCMCSettings,
-                  directory: Path, figures: bool = True,
-                  note: str = "recording as given") -> Fit:
-    """TMCMC on ``problem`` and its files in ``directory`` (resumed when finished there)."""
+                  directory: Path, figure: FitFigure | None = None) -> Fit:
+    """TMCMC on ``problem`` and its files in ``directory`` (resumed when finished there);
+    ``figure`` draws the posterior's figure (``plots.posterior.fit_pair_figure``)."""
     done = load_fit(directory, problem, priors)
     if done is not None:
         return done
     idata = identify(problem, priors, settings)
     fit = Fit(problem, idata, priors, evidence_summary(idata))
-    write_fit(fit, directory, figures, note)
+    write_fit(fit, directory, figure)
     log.info("%s: log evidence %.2f%s", problem.structure.name, fit.evidence["log_evidence"],
              f" +- {fit.evidence['standard_error']:.2f}" if fit.evidence["standard_error"]
              else "")
     return fit
 
 
-def write_fit(fit: Fit, directory: Path, figures: bool = True,
-              note: str = "recording as given") -> list[str]:
-    """posterior.nc, summary.csv, the pair figure, then evidence.json; the file names."""
+def write_fit(fit: Fit, directory: Path, figure: FitFigure | None = None) -> list[str]:
+    """posterior.nc, summary.csv, ``figure``'s file (the pair figure,
+    ``plots.posterior.fit_pair_figure``), then evidence.json; the file names."""
     directory.mkdir(parents=True, exist_ok=True)
     with atomic_path(directory / "posterior.nc") as tmp:
         fit.idata.to_netcdf(str(tmp))
@@ -173,12 +178,7 @@ def write_fit(fit: Fit, directory: Path, figures: bool = True,
     with atomic_path(directory / "summary.csv") as tmp:
         table.to_csv(tmp, index=False, float_format="%.6g")
     files = ["posterior.nc", "summary.csv"]
-    if figures:
-        from harvester.plots.posterior import pair_plot
-        names = parameter_names(fit.idata)
-        pair_plot(posterior_theta(fit.idata), names, directory / "posterior_pairs.png",
-                  f"posterior of {fit.problem.structure.name}", note=note,
-                  units={n: s.unit for n, s in fit.priors.items()})
-        files.append("posterior_pairs.png")
+    if figure is not None:
+        files.append(figure(fit, directory))
     write_json(fit.evidence, directory / "evidence.json")
     return files + ["evidence.json"]

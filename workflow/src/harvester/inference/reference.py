@@ -27,6 +27,8 @@ it would bias the evidence low.
 
 from __future__ import annotations
 
+import logging
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -35,6 +37,8 @@ from scipy import stats
 from scipy.special import logsumexp
 
 from harvester.inference.priors import PriorSpec
+
+log = logging.getLogger("harvester.inference")
 
 __all__ = ["GaussianFactor", "Reference", "ScanFactor"]
 
@@ -250,3 +254,34 @@ class Reference:
                     "mean": [float(m) for m in f.mean],
                     "sd": [float(np.sqrt(f.cov[i][i])) for i in range(len(f.names))]})
         return out
+
+
+def support(priors: Mapping[str, PriorSpec], names) -> tuple[tuple[float, ...], ...]:
+    """(lowers, uppers) of the priors of ``names``: where a reference may put particles."""
+    return (tuple(float(priors[n].lower) for n in names),
+            tuple(float(priors[n].upper) for n in names))
+
+
+#: Share of a candidate's initial particles drawn from the reference rather than the prior.
+REFERENCE_SHARE = 0.5
+#: The nested model's posterior sds are widened by this factor in the reference.
+REFERENCE_WIDEN = 1.5
+
+
+def map_reference(point, priors: Mapping[str, PriorSpec]) -> Reference | None:
+    """Where a baseline's TMCMC starts half its particles: a Gaussian at its MAP with the
+    Laplace covariance widened by REFERENCE_WIDEN, sigma at the MAP's RMS residual with a
+    fifth of it as sd (``map_fit.PointFit``); the other half from the prior. None when the
+    Laplace covariance is not usable."""
+    names = tuple(point.names)
+    p = len(point.theta) - 1
+    cov = np.zeros((p + 1, p + 1))
+    cov[:p, :p] = np.asarray(point.cov) * REFERENCE_WIDEN**2
+    cov[p, p] = (0.2 * point.theta[-1]) ** 2
+    try:
+        gaussian = GaussianFactor(names, tuple(map(float, point.theta)),
+                                  tuple(map(tuple, cov)), *support(priors, names))
+    except ValueError as err:
+        log.warning("no Gaussian start at the MAP (%s): tempering from the prior", err)
+        return None
+    return Reference({n: priors[n] for n in names}, (gaussian,), REFERENCE_SHARE)

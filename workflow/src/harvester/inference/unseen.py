@@ -12,6 +12,7 @@ after the lead-in (and before the filter's end effects).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -117,24 +118,17 @@ def predictive_frame(pred: Prediction) -> pd.DataFrame:
                          "sd_parameter": b.sd_parameter}, columns=PREDICTIVE_COLUMNS)
 
 
-def write_prediction(pred: Prediction, directory: Path, figures: bool = True,
-                     note: str = "recording as given") -> list[str]:
-    """predictive.csv, the response figure and validation.json (last); the file names."""
+def write_prediction(pred: Prediction, directory: Path,
+                     figure: Callable[[Prediction, Path], str] | None = None) -> list[str]:
+    """predictive.csv, ``figure``'s file (the response figure,
+    ``plots.predictive.prediction_figure``) and validation.json (last); the file names."""
     from harvester.data.fileio import atomic_path, write_json
     directory.mkdir(parents=True, exist_ok=True)
     with atomic_path(directory / "predictive.csv") as tmp:
         predictive_frame(pred).to_csv(tmp, index=False, float_format="%.9g")
     files = ["predictive.csv"]
-    if figures:
-        from harvester.plots.predictive import response_figure
-        unit = pred.metrics["unit"]
-        what = "relative acceleration (m/s$^2$)" if unit == "m/s^2" else \
-            "relative displacement (m)"
-        response_figure(pred.band, pred.measured, directory / "predictive.png",
-                        f"{pred.metrics['model']}: posterior predictive, NRMSE "
-                        f"{pred.metrics['nrmse']:.3f}", note=note, ylabel=what,
-                        measured_label="measured")
-        files.append("predictive.png")
+    if figure is not None:
+        files.append(figure(pred, directory))
     write_json(pred.metrics, directory / "validation.json")
     return files + ["validation.json"]
 

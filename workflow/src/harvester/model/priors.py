@@ -186,7 +186,7 @@ class DeviceScale:
 
 
 #: Quantiles of |z| a device's scale records (``DeviceScale.z_quantiles``; 1.0: the largest),
-#: as ``harvester.diagnosis.signatures.Z_QUANTILES``.
+#: as ``harvester.diagnosis.detect.signatures.Z_QUANTILES``.
 Z_QUANTILES = (0.5, 0.75, 0.9, 0.97, 0.99, 0.999, 1.0)
 
 

@@ -65,3 +65,16 @@ def _mark_1d(ax, name, values, color, what) -> None:  # noqa: ANN001
 def _mark_2d(ax, x, y, values, color, marker) -> None:  # noqa: ANN001
     if values and x in values and y in values:
         ax.plot(values[x], values[y], marker, color=color, ms=10, mew=2)
+
+
+def fit_pair_figure(note: str = "recording as given"):
+    """A ``recording_fit.FitFigure``: the posterior's pair figure of a fit, with ``note``
+    under it, as posterior_pairs.png in the fit's directory."""
+    def draw(fit, directory: Path) -> str:
+        from harvester.inference.posterior import parameter_names, posterior_theta
+        pair_plot(posterior_theta(fit.idata), parameter_names(fit.idata),
+                  directory / "posterior_pairs.png",
+                  f"posterior of {fit.problem.structure.name}", note=note,
+                  units={n: s.unit for n, s in fit.priors.items()})
+        return "posterior_pairs.png"
+    return draw

@@ -130,3 +130,18 @@ def _misfit_panel(ax, m: StickMisfit, unit: str,
                  f"({100 * m.near_share:.1f} %): {m.absolute_ratio:.2f} x the misfit "
                  f"elsewhere,\n{m.relative_ratio:.2f} x relative to the record there",
                  fontsize=TITLE_SIZE)
+
+
+def prediction_figure(note: str = "recording as given"):
+    """Draws a prediction's (``inference.unseen.Prediction``) response figure, with ``note``
+    under it, as predictive.png in its directory; returns the file name."""
+    def draw(pred, directory: Path) -> str:
+        unit = pred.metrics["unit"]
+        what = "relative acceleration (m/s$^2$)" if unit == "m/s^2" else \
+            "relative displacement (m)"
+        response_figure(pred.band, pred.measured, directory / "predictive.png",
+                        f"{pred.metrics['model']}: posterior predictive, NRMSE "
+                        f"{pred.metrics['nrmse']:.3f}", note=note, ylabel=what,
+                        measured_label="measured")
+        return "predictive.png"
+    return draw

@@ -18,6 +18,7 @@ import pandas as pd
 from harvester.study import paper
 from harvester.initial.damping import DampingFit, DampingSummary
 from harvester.initial.static_friction import StaticFrictionEstimate
+from harvester.inference.priors import PriorSpec
 
 #: Columns of every comparison table, in order.
 COLUMNS: list[str] = ["parameter", "value", "unit", "paper", "truth"]
@@ -25,6 +26,44 @@ COLUMNS: list[str] = ["parameter", "value", "unit", "paper", "truth"]
 #: Footnote carried by every rendered table.
 SIMULATED_NOTE = ("Recordings from the virtual rig (SIMULATED), not the paper's measurements; "
                   "'truth' is the virtual rig's parameter.")
+
+
+#: The paper's prior tables, by model structure.
+PAPER_PRIORS: dict[str, Mapping[str, tuple[float, float | None]]] = {
+    "linear": paper.TABLE2, "tanh": paper.TABLE4,
+}
+
+
+def _paper_priors_for(model_params: Sequence[str]) -> Mapping[str, tuple[float, float | None]]:
+    """The paper table whose parameters are exactly ``model_params`` (Table 2 or Table 4)."""
+    for table in PAPER_PRIORS.values():
+        if set(table) == set(model_params):
+            return table
+    return paper.TABLE4
+
+
+def prior_table(model_params: Sequence[str], specs: Mapping[str, PriorSpec],
+                paper_priors: Mapping[str, tuple[float, float | None]] | None = None
+                ) -> pd.DataFrame:
+    """Our priors beside the paper's (Table 2 or 4) for the parameters of one model.
+
+    Columns: parameter, mean, sd, unit, paper_mean, paper_sd (NaN where the paper gives
+    none, e.g. sigma's sd in Table 2). ``paper_priors`` defaults to the paper table with the
+    same parameter set (Table 2 for {c_m, sigma}, otherwise Table 4).
+    """
+    missing = [p for p in model_params if p not in specs]
+    if missing:
+        raise ValueError(f"no prior for {missing}; config priors has {sorted(specs)}")
+    reference = _paper_priors_for(model_params) if paper_priors is None else paper_priors
+    rows = []
+    for name in model_params:
+        spec = specs[name]
+        paper_mean, paper_sd = reference.get(name, (np.nan, np.nan))
+        rows.append({"parameter": name, "mean": spec.mean, "sd": spec.sd, "unit": spec.unit,
+                     "paper_mean": float(paper_mean),
+                     "paper_sd": np.nan if paper_sd is None else float(paper_sd)})
+    return pd.DataFrame(rows, columns=["parameter", "mean", "sd", "unit", "paper_mean",
+                                       "paper_sd"])
 
 
 def compare_table(ours: Mapping[str, float], paper_values: Mapping[str, float],

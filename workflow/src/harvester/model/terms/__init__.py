@@ -148,7 +148,7 @@ class Term:
     data resolve is Coulomb friction; a mode far above the band is a mass). A posterior piled
     there is not trusted, and the diagnosis samples the other term in its place.
     ``nameable``: False for a shape of the missing force's dictionary fitted as a term
-    (``diagnosis.shape_terms``): it describes what the library lacks and is never a
+    (``diagnosis.size.shape_terms``): it describes what the library lacks and is never a
     candidate the diagnosis names.
     """
 

@@ -1,9 +1,9 @@
 """A force periodic in the displacement: f = a_periodic sin(2 pi z / P_periodic)
 + b_periodic cos(2 pi z / P_periodic).
 
-Not a library name: a shape of the missing force's dictionary (``diagnosis.shapes``'s
+Not a library name: a shape of the missing force's dictionary (``diagnosis.size.shapes``'s
 "periodic in z": cogging, a ball screw's or a gear's pitch, a magnetic detent) fitted as a
-term of the model (``diagnosis.shape_terms``), along the model's own simulated z. The
+term of the model (``diagnosis.size.shape_terms``), along the model's own simulated z. The
 smoother reads z from the record and, on an acceleration record of a small motion, knows it
 only to a fraction of a millimetre (a cogging record of the literature generator: 86 um RMS
 known to +-124 um, period 0.1 mm); the model's own z, driven by the recorded input, does not

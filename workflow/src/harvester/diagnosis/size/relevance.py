@@ -41,9 +41,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from harvester.data.units import SI, Units
-from harvester.diagnosis.latent import LatentForce
-from harvester.diagnosis.latent_views import EffectForce, parameter_values
-from harvester.diagnosis.term_forces import term_force
+from harvester.diagnosis.size.latent import LatentForce
+from harvester.diagnosis.size.views import EffectForce, parameter_values
+from harvester.model.term_forces import term_force
 from harvester.model.structures import ModelStructure
 from harvester.model.terms import term
 

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from pathlib import Path
 
 import numpy as np
 
-from harvester.diagnosis.baseline import ChainProblem
-from harvester.diagnosis.fits import prior_dict
+from harvester.inference.map_fit import ChainProblem
+from harvester.diagnosis.name.fits import prior_dict
+from harvester.diagnosis.report.thresholds import thresholds
 from harvester.inference.predictive import nrmse, outside_fraction, thin
 
 
@@ -159,6 +161,29 @@ def _finite(obj):
     return obj
 
 
+#: The version of diagnosis.json's contract (``diagnosis.schema.json`` beside this module,
+#: docs/diagnosis-json.md): the major number changes when a key is removed or changes its
+#: meaning, the minor one when a key is added.
+SCHEMA_VERSION = "1.0"
+#: The JSON Schema diagnosis.json validates against, shipped with the package.
+SCHEMA_PATH = Path(__file__).with_name("diagnosis.schema.json")
+
+
+def validate_document(doc: dict) -> None:
+    """Check a diagnosis.json document against its schema (:data:`SCHEMA_PATH`, with the
+    ``jsonschema`` package); ValueError naming the first key that breaks it."""
+    import json
+
+    import jsonschema
+    schema = json.loads(SCHEMA_PATH.read_text())
+    error = jsonschema.exceptions.best_match(
+        jsonschema.Draft202012Validator(schema).iter_errors(doc))
+    if error is not None:
+        where = "/".join(map(str, error.absolute_path)) or "(top level)"
+        raise ValueError(f"diagnosis.json does not follow schema {SCHEMA_VERSION} at "
+                         f"{where}: {error.message}")
+
+
 def diagnosis_dict(d) -> dict:
     """The JSON document of a :class:`~harvester.diagnosis.run.Diagnosis` (no NaN: None)."""
     return _finite(_diagnosis_dict(d))
@@ -232,6 +257,7 @@ def _diagnosis_dict(d) -> dict:
     s = d.settings
     judged = d.fit_judgement
     return {
+        "schema_version": SCHEMA_VERSION,
         "verdict": d.verdict,
         "headline": d.headline,
         "explained_share": None if judged is None else judged.explained,
@@ -265,4 +291,5 @@ def _diagnosis_dict(d) -> dict:
         "runtime_s": d.seconds,
         "notes": d.notes,
         "figures": list(getattr(d, "figure_files", [])),
+        "thresholds": thresholds(),
     }

@@ -41,12 +41,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from harvester.data.signals import chain_cutoff
-from harvester.diagnosis.baseline import BaselineState
-from harvester.diagnosis.locate import (FrequencyBands, MeasuredStandstill, Standardised,
+from harvester.inference.map_fit import BaselineState
+from harvester.diagnosis.detect.locate import (FrequencyBands, MeasuredStandstill, Standardised,
                                         StateRegions, TimeWindows, standardise)
-from harvester.diagnosis.signatures import Signature, motion_scale, signatures
-from harvester.diagnosis.tail import TailP, tail_p
-from harvester.diagnosis.spectral import (Frame, Metric, Projector, level_envelope,
+from harvester.diagnosis.detect.signatures import Signature, motion_scale, signatures
+from harvester.inference.tail import TailP, tail_p
+from harvester.diagnosis.detect.spectral import (Frame, Metric, Projector, level_envelope,
                                           noise_replicates, removed_input_psd)
 from harvester.inference.priors import PriorSpec
 from harvester.inference.priors import default_prior

@@ -8,9 +8,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from harvester.data.units import Units
-from harvester.diagnosis.latent import LatentForce
-from harvester.diagnosis.latent_views import Binned, EffectForce, views
-from harvester.diagnosis.shapes import ShapeDescription
+from harvester.diagnosis.size.latent import LatentForce
+from harvester.diagnosis.size.views import Binned, EffectForce, views
+from harvester.diagnosis.size.shapes import ShapeDescription
 from harvester.plots.style import (BOUNDS, LEGEND_SIZE, MEASURED, MODEL, TITLE_SIZE,
                                    axis_label, plt, save_figure)
 

@@ -16,15 +16,15 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from harvester.diagnosis.analysis import Analysis, BaselineStart
-from harvester.diagnosis.baseline import BaselineState, baseline_state
-from harvester.diagnosis.confirm import CandidateResult, confirm, fit_structure
-from harvester.diagnosis.fits import ModelFit
-from harvester.diagnosis.detect import Detection, detect
-from harvester.diagnosis.rank import RankedCandidate, rank, rivals, to_confirm
-from harvester.diagnosis.screen import Screen, screen
-from harvester.diagnosis.settings import DiagnosisSettings
-from harvester.diagnosis.signatures import candidate_terms, motion_scale
+from harvester.diagnosis.prepare.analysis import Analysis, BaselineStart
+from harvester.inference.map_fit import BaselineState, baseline_state
+from harvester.diagnosis.name.confirm import CandidateResult, confirm, fit_structure
+from harvester.diagnosis.name.fits import ModelFit
+from harvester.diagnosis.detect.scores import Detection, detect
+from harvester.diagnosis.name.rank import RankedCandidate, rank, rivals, to_confirm
+from harvester.diagnosis.name.screen import Screen, screen
+from harvester.diagnosis.prepare.settings import DiagnosisSettings
+from harvester.diagnosis.detect.signatures import candidate_terms, motion_scale
 from harvester.model.priors import DeviceScale
 from harvester.model.structures import ModelStructure
 

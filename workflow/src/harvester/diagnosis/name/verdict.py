@@ -25,16 +25,16 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
 from harvester.data.units import SI, Units
-from harvester.diagnosis.confirm import CandidateResult
-from harvester.diagnosis.fits import ModelFit
-from harvester.diagnosis.detect import Detection
-from harvester.diagnosis.floor import Floor
-from harvester.diagnosis.missing_force import MissingForce
-from harvester.diagnosis.relevance import OwnForce
-from harvester.diagnosis.rounds import Round, rough_rivals
-from harvester.diagnosis.separate import Separation, separations
-from harvester.diagnosis.shapes import beyond_uncertainty, has_its_shape, library_terms
-from harvester.diagnosis.settings import DiagnosisSettings
+from harvester.diagnosis.name.confirm import CandidateResult
+from harvester.diagnosis.name.fits import ModelFit
+from harvester.diagnosis.detect.scores import Detection
+from harvester.diagnosis.detect.floor import Floor
+from harvester.diagnosis.size.missing_force import MissingForce
+from harvester.diagnosis.size.relevance import OwnForce
+from harvester.diagnosis.name.rounds import Round, rough_rivals
+from harvester.diagnosis.name.separate import Separation, separations
+from harvester.diagnosis.size.shapes import beyond_uncertainty, has_its_shape, library_terms
+from harvester.diagnosis.prepare.settings import DiagnosisSettings
 
 log = logging.getLogger("harvester.diagnosis")
 

@@ -59,10 +59,10 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from harvester.diagnosis.baseline import (PILE_NATS, PointFit, PriorCoordinates, bound_pull,
+from harvester.inference.map_fit import (PILE_NATS, PointFit, PriorCoordinates, bound_pull,
                                           chain_problem, fit_map)
-from harvester.diagnosis.fits import ModelFit, candidate_priors, scan_factor
-from harvester.diagnosis.detect import EDGE_SHARE, Detection
+from harvester.diagnosis.name.fits import ModelFit, candidate_priors, scan_factor
+from harvester.diagnosis.detect.scores import EDGE_SHARE, Detection
 from harvester.inference.importance import (Component, ImportanceEstimate, MixtureProposal,
                                             importance_log_evidence, resample)
 from harvester.inference.likelihood import sigma_marginal_loglike

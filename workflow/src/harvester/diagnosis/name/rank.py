@@ -27,8 +27,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from harvester.diagnosis.baseline import BaselineState
-from harvester.diagnosis.detect import CandidateScore, Detection
+from harvester.inference.map_fit import BaselineState
+from harvester.diagnosis.detect.scores import CandidateScore, Detection
 from harvester.inference.priors import PriorSpec
 from harvester.inference.priors import default_prior
 

@@ -45,8 +45,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import optimize, signal, special, stats
 
-from harvester.diagnosis.latent import LatentForce
-from harvester.diagnosis.term_forces import term_force
+from harvester.diagnosis.size.latent import LatentForce
+from harvester.model.term_forces import term_force
 from harvester.model.structures import structure
 from harvester.model.terms import TERMS, is_friction, term
 

@@ -23,12 +23,13 @@ from harvester.data.errors import DataError
 from harvester.data.input_noise import (NoiseFloor, SharedNoise, noise_floor, shared_noise,
                                        without_floor)
 from harvester.data.signals import resample_recording, resampling_ratio, uniform_step
-from harvester.diagnosis.baseline import ChainProblem, baseline_state, chain_problem, fit_map
-from harvester.diagnosis.confirm import fit_structure, map_reference
-from harvester.diagnosis.fits import ModelFit
-from harvester.diagnosis.detect import band_top, estimate_temper
-from harvester.diagnosis.settings import DiagnosisSettings
-from harvester.diagnosis.spectral import recording_lowpass
+from harvester.inference.map_fit import ChainProblem, baseline_state, chain_problem, fit_map
+from harvester.diagnosis.name.confirm import fit_structure
+from harvester.inference.reference import map_reference
+from harvester.diagnosis.name.fits import ModelFit
+from harvester.diagnosis.detect.scores import band_top, estimate_temper
+from harvester.diagnosis.prepare.settings import DiagnosisSettings
+from harvester.diagnosis.detect.spectral import recording_lowpass
 from harvester.inference.problems import make_problem
 from harvester.inference.posterior import (log_evidence as idata_log_evidence,
                                           parameter_names as idata_parameter_names,

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from harvester.diagnosis.baseline import BaselineState
+from harvester.inference.map_fit import BaselineState
 from harvester.model.priors import REFERENCE_DEVICE, DeviceScale
 from harvester.model.simulate import simulate
 from harvester.model.structures import Layout

@@ -24,10 +24,10 @@ from dataclasses import dataclass, field, replace
 
 import pandas as pd
 
-from harvester.diagnosis.analysis import default_priors, prepare
-from harvester.diagnosis.baseline import fit_map
-from harvester.diagnosis.detect import estimate_temper
-from harvester.diagnosis.settings import DiagnosisSettings
+from harvester.diagnosis.prepare.analysis import default_priors, prepare
+from harvester.inference.map_fit import fit_map
+from harvester.diagnosis.detect.scores import estimate_temper
+from harvester.diagnosis.prepare.settings import DiagnosisSettings
 from harvester.model.structures import structure as named_structure
 
 log = logging.getLogger("harvester.diagnosis")
@@ -107,7 +107,7 @@ def choose_topology(df: pd.DataFrame, known: Mapping[str, float], baseline: str,
     forms = {f: _form(df, known, f, source) for f in FORMS}
     if settings.lowpass_hz is None:  # one low-pass for both: the recording's, as recorded
         from harvester.data.signals import uniform_step
-        from harvester.diagnosis.spectral import recording_lowpass
+        from harvester.diagnosis.detect.spectral import recording_lowpass
         dt = uniform_step(df["time"].to_numpy(dtype=float), source)
         settings = replace(settings, lowpass_hz=recording_lowpass(
             None, df["base_disp"].to_numpy(dtype=float), df["rel_disp"].to_numpy(dtype=float),

@@ -23,8 +23,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from harvester.data.units import SI, Units
-from harvester.diagnosis.latent import LatentForce
-from harvester.diagnosis.term_forces import model_force, term_force
+from harvester.diagnosis.size.latent import LatentForce
+from harvester.model.term_forces import model_force, term_force
 from harvester.model.structures import Layout, ModelStructure, structure
 from harvester.model.terms import term
 

@@ -6,9 +6,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from harvester.data.units import SI, Units, read_units
-from harvester.diagnosis.confirm import ConfirmSettings
-from harvester.diagnosis.detect import DetectionSettings
-from harvester.diagnosis.relevance import RelevanceFloor
+from harvester.diagnosis.name.confirm import ConfirmSettings
+from harvester.diagnosis.detect.scores import DetectionSettings
+from harvester.diagnosis.size.relevance import RelevanceFloor
 
 
 @dataclass(frozen=True)

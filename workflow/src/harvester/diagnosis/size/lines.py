@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage, optimize, signal
 
-from harvester.diagnosis.latent import LatentForce
+from harvester.diagnosis.size.latent import LatentForce
 
 #: Family-wise false-alarm rate over the bins tested.
 LINE_ALPHA = 1e-3

@@ -62,11 +62,11 @@ from scipy import linalg, optimize, signal
 
 from harvester.data.signals import butterworth_sos, lowpass
 from harvester.data.units import SI, Units
-from harvester.diagnosis.baseline import BaselineState
-from harvester.diagnosis.state_space import (MATERN_STATES, Discrete, backward_sample,
+from harvester.inference.map_fit import BaselineState
+from harvester.inference.state_space import (MATERN_STATES, Discrete, backward_sample,
                                              discretise, filtered_noise, kalman_filter,
                                              kalman_loglik, matern, rts_smoother)
-from harvester.diagnosis.term_forces import term_forces
+from harvester.model.term_forces import term_forces
 
 log = logging.getLogger("harvester.diagnosis")
 

@@ -33,8 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from harvester.diagnosis.baseline import PointFit, PriorCoordinates
-from harvester.diagnosis.screen import profiled_rows
+from harvester.inference.map_fit import PointFit, PriorCoordinates
+from harvester.diagnosis.name.screen import profiled_rows
 from harvester.inference.priors import PriorSpec
 
 #: Steps from the MAP along each parameter, in its Laplace standard deviation.

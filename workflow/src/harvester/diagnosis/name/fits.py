@@ -17,14 +17,14 @@ from dataclasses import dataclass, field
 import arviz as az
 import numpy as np
 
-from harvester.diagnosis.baseline import ChainProblem
-from harvester.diagnosis.detect import Detection
+from harvester.inference.map_fit import ChainProblem
+from harvester.diagnosis.detect.scores import Detection
 from harvester.inference.correlated_residuals import correlation_adjustment
 from harvester.inference.evidence import BridgeEstimate
 from harvester.inference.importance import ImportanceEstimate
 from harvester.inference.posterior import pooled_log_evidence
 from harvester.inference.priors import PriorSpec
-from harvester.inference.reference import Reference, ScanFactor
+from harvester.inference.reference import Reference, ScanFactor, support
 from harvester.model.priors import DeviceScale
 from harvester.model.structures import ModelStructure
 from harvester.model.terms import term
@@ -199,9 +199,3 @@ def scan_factor(effect: str, detection: Detection | None,
     except ValueError as err:  # the scan lies outside the prior
         log.warning("no scan start for %s (%s)", effect, err)
         return None
-
-
-def support(priors: Mapping[str, PriorSpec], names) -> tuple[tuple[float, ...], ...]:
-    """(lowers, uppers) of the priors of ``names``: where a reference may put particles."""
-    return (tuple(float(priors[n].lower) for n in names),
-            tuple(float(priors[n].upper) for n in names))

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import signal
 
-from harvester.diagnosis.baseline import ChainProblem, fit_map
+from harvester.inference.map_fit import ChainProblem, fit_map
 from harvester.inference.likelihood import Problem
 
 log = logging.getLogger("harvester.diagnosis")

@@ -12,15 +12,15 @@ from pathlib import Path
 import numpy as np
 
 from harvester.data.units import SI, Units
-from harvester.diagnosis.baseline import BaselineState
-from harvester.diagnosis.latent import LatentForce, latent_force
-from harvester.diagnosis.latent_views import Binned, EffectForce, effect_force, views
-from harvester.diagnosis.lines import ResidualLine, residual_line
-from harvester.diagnosis.relevance import (EffectSize, OwnForce, RelevanceFloor, drive_rms,
+from harvester.inference.map_fit import BaselineState
+from harvester.diagnosis.size.latent import LatentForce, latent_force
+from harvester.diagnosis.size.views import Binned, EffectForce, effect_force, views
+from harvester.diagnosis.size.lines import ResidualLine, residual_line
+from harvester.diagnosis.size.relevance import (EffectSize, OwnForce, RelevanceFloor, drive_rms,
                                            effect_size, own_span, response_change, ridge,
                                            term_force_rms)
-from harvester.diagnosis.shapes import ShapeDescription, describe
-from harvester.diagnosis.shape_terms import ShapeTermFit
+from harvester.diagnosis.size.shapes import ShapeDescription, describe
+from harvester.diagnosis.size.shape_terms import ShapeTermFit
 from harvester.model.structures import ModelStructure
 
 
@@ -126,7 +126,7 @@ def missing_force(state: BaselineState, window: tuple[int, int] | None = None,
                                      on_ridge, effect.adjusted, span_drive))
     out.together = together_force(state.problem, named, record_input)
     if out_dir is not None:
-        from harvester.diagnosis.latent_figures import all_latent_figures
+        from harvester.diagnosis.size.figures import all_latent_figures
         out.figure_files = all_latent_figures(lf, desc, out_dir, out.effects,
                                               [s.explains for s in out.sizes])
     return out

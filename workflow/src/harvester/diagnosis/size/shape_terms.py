@@ -33,8 +33,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from harvester.data.units import SI, Units
-from harvester.diagnosis.baseline import ChainProblem, PointFit, chain_problem, fit_map
-from harvester.diagnosis.fits import ModelFit, candidate_priors
+from harvester.inference.map_fit import ChainProblem, PointFit, chain_problem, fit_map
+from harvester.diagnosis.name.fits import ModelFit, candidate_priors
 from harvester.inference.priors import PriorSpec
 from harvester.model.priors import DeviceScale
 

@@ -33,7 +33,7 @@ peak in f_mode that few prior draws hit.
 
 Start. A candidate's TMCMC tempers from a reference distribution, not from the prior
 (``harvester.inference.reference``, :func:`start_of`): half its initial particles at its MAP
-with the Laplace covariance widened (``diagnosis.screen`` fitted it), as the baseline's
+with the Laplace covariance widened (``diagnosis.name.screen`` fitted it), as the baseline's
 start; where it was not fitted, at the nested model's posterior (widened) for the shared
 parameters and, for a ``Probe.start_shape`` (a mode's frequency), the detection's scan
 (:func:`candidate_reference`). The other half come from the prior, which bounds the
@@ -52,13 +52,13 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from harvester.diagnosis.baseline import ChainProblem, chain_problem
-from harvester.diagnosis.detect import Detection, at_prior_edge
-from harvester.diagnosis.fits import (BRIDGE_MIN_SE, MISSED_MODE_NATS, ModelFit, candidate_priors,
-                                      prior_dict, scan_factor, support)
-from harvester.diagnosis.screen import Screen
-from harvester.diagnosis.signatures import candidate_terms
-from harvester.diagnosis.smoothness import smoothness
+from harvester.inference.map_fit import ChainProblem, chain_problem
+from harvester.diagnosis.detect.scores import Detection, at_prior_edge
+from harvester.diagnosis.name.fits import (BRIDGE_MIN_SE, MISSED_MODE_NATS, ModelFit, candidate_priors,
+                                      prior_dict, scan_factor)
+from harvester.diagnosis.name.screen import Screen
+from harvester.diagnosis.detect.signatures import candidate_terms
+from harvester.diagnosis.name.smoothness import smoothness
 from harvester.model.priors import DeviceScale
 from harvester.inference.evidence import BridgeEstimate, chains_bridge_log_evidence, log_target
 from harvester.inference.identify import TMCMCSettings, identify
@@ -66,7 +66,8 @@ from harvester.inference.posterior import posterior_theta, pooled_log_evidence, 
 from harvester.model.terms import same_physics, term
 from harvester.inference.priors import PriorSpec
 from harvester.inference.priors import priors_for
-from harvester.inference.reference import GaussianFactor, Reference
+from harvester.inference.reference import (REFERENCE_SHARE, REFERENCE_WIDEN, GaussianFactor,
+                                           Reference, map_reference, support)
 from harvester.model.structures import ModelStructure
 
 log = logging.getLogger("harvester.diagnosis")
@@ -182,12 +183,6 @@ def candidate_particles(effect: str, particles: int) -> int:
     return int(particles * max(1.0, len(term(effect).parameters) / 2.0))
 
 
-#: Share of a candidate's initial particles drawn from the reference rather than the prior.
-REFERENCE_SHARE = 0.5
-#: The nested model's posterior sds are widened by this factor in the reference.
-REFERENCE_WIDEN = 1.5
-
-
 def candidate_reference(effect: str, nested: ModelFit, detection: Detection | None,
                         priors: Mapping[str, PriorSpec]) -> Reference | None:
     """Where the TMCMC of a candidate starts half its particles (``harvester.inference.
@@ -218,25 +213,6 @@ def candidate_reference(effect: str, nested: ModelFit, detection: Detection | No
     factors = (gaussian,) if scan is None else (gaussian, scan)
     names = (*nested.names, *(() if scan is None else (scan.name,)))
     return Reference({n: priors[n] for n in names}, factors, REFERENCE_SHARE)
-
-
-def map_reference(point, priors: Mapping[str, PriorSpec]) -> Reference | None:
-    """Where a baseline's TMCMC starts half its particles: a Gaussian at its MAP with the
-    Laplace covariance widened by REFERENCE_WIDEN, sigma at the MAP's RMS residual with a
-    fifth of it as sd (``baseline.PointFit``); the other half from the prior. None when the
-    Laplace covariance is not usable."""
-    names = tuple(point.names)
-    p = len(point.theta) - 1
-    cov = np.zeros((p + 1, p + 1))
-    cov[:p, :p] = np.asarray(point.cov) * REFERENCE_WIDEN**2
-    cov[p, p] = (0.2 * point.theta[-1]) ** 2
-    try:
-        gaussian = GaussianFactor(names, tuple(map(float, point.theta)),
-                                  tuple(map(tuple, cov)), *support(priors, names))
-    except ValueError as err:
-        log.warning("no Gaussian start at the MAP (%s): tempering from the prior", err)
-        return None
-    return Reference({n: priors[n] for n in names}, (gaussian,), REFERENCE_SHARE)
 
 
 #: A final TMCMC stage accepting at least this share of its moves had collapsed onto copies
@@ -389,7 +365,7 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
     """Sample each augmented structure; evidence against the baseline; acceptance.
     ``detection``: the round's detection, whose scans place the start of candidates with a
     ``Probe.start_shape`` (:func:`candidate_reference`). ``screen``: the candidates' best
-    fits (``diagnosis.screen``); then they are sampled in its order, at most ``top`` of them,
+    fits (``diagnosis.name.screen``); then they are sampled in its order, at most ``top`` of them,
     and one whose evidence bound rules it out is not sampled (:func:`skip_reason`). Those
     whose best fit lies on a bound their posterior must pile against (``Screened.pulled``)
     come last: they can only tie with a candidate accepted before them."""
@@ -542,7 +518,7 @@ def limit_candidates(effect: str, edges: Mapping[str, str], structure: ModelStru
 def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSettings,
                 top: int | None, nested_se: float = BRIDGE_MIN_SE,
                 single_scores: bool = False) -> str | None:
-    """Why a screened candidate (``diagnosis.screen.Screened``) need not be sampled: ``top``
+    """Why a screened candidate (``diagnosis.name.screen.Screened``) need not be sampled: ``top``
     candidates were sampled already, or its evidence bound (``Screened.bound``) or its
     importance-sampling ceiling (``Screened.importance_ceiling``, where trusted) lies below the
     acceptance threshold (``acceptance_base`` plus mc_sigmas times the root sum of squares of

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from harvester.diagnosis.spectral import Frame
+from harvester.diagnosis.detect.spectral import Frame
 
 #: Octave band edges (Hz); the first and last are clipped to the analysed band.
 BAND_EDGES_HZ = (0.0, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0, 256.0, 512.0)

@@ -1,0 +1,12 @@
+"""Stage 3, name: which library term the baseline is missing, confirmed by evidence.
+
+``fits``         what is carried from step to step: a model sampled under its likelihood
+                 (``ModelFit``), a candidate's priors on this device, the scan's start
+``rank``         the candidates ranked cheaply by their signatures
+``screen``       the candidates' best fits (MAP), which bound the evidence each can gain
+``smoothness``   whether a candidate's likelihood is smooth enough to sample
+``confirm``      TMCMC of the augmented structures, their evidence, ties
+``rounds``       detect -> rank -> screen -> confirm, one effect added per round
+``separate``     the measurement that would tell two tied effects apart
+``verdict``      what is concluded: the verdict, the names, the ties, what is withheld
+"""
