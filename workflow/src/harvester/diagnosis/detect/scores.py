@@ -16,7 +16,7 @@ candidate effect (``signatures.py``), z = <g_perp, r> / sd with sd from the repl
 one-sided for effects whose strength cannot be negative; an effect's statistic is the largest
 z^2 over its shape grid and the family's the largest over effects; its p-value is the share of
 replicates whose largest statistic is at least as large, or, where fewer than ten replicates
-reach it, the generalised Pareto tail of the replicates (``tail.py``), so that it can fall below
+reach it, the generalised Pareto tail of the replicates (``inference.tail``), so that it can fall below
 1 / (bootstrap + 1). False alarms on recordings of the
 baseline itself stay at most alpha = 0.05 over 60 seeds (tests/test_diagnosis_calibration.py).
 

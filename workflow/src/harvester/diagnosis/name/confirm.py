@@ -3,7 +3,7 @@
 Each candidate is the baseline with one more term of the library
 (``ModelStructure.with_term``), sampled by TMCMC (``identify``) under the same likelihood as
 the baseline: eq. (10) through the measurement chain, tempered by lambda, the effective
-share of independent samples (``baseline.ChainProblem``), so that evidences are comparable and
+share of independent samples (``map_fit.ChainProblem``), so that evidences are comparable and
 not inflated by the correlation of the low-passed residuals.
 
 Acceptance. For data from the baseline, the Bayes factor B of any alternative has
@@ -323,7 +323,7 @@ def candidate_fit(baseline: ModelFit, effect: str, priors: Mapping[str, PriorSpe
     """The baseline with one more term, sampled by TMCMC: its priors (the candidate's
     scaled to this device, ``priors`` winning), its particles (:func:`candidate_particles`)
     and its start (:func:`start_of`, sampled again from the prior if that population
-    collapsed). ``point``: the candidate's MAP (``baseline.PointFit``) where it was fitted."""
+    collapsed). ``point``: the candidate's MAP (``map_fit.PointFit``) where it was fitted."""
     structure = baseline.structure.with_term(effect)
     specs = {**candidate_priors(effect, scale, baseline.problem.known), **priors}
     run = replace(settings, particles=candidate_particles(effect, settings.particles))

@@ -2,8 +2,8 @@
 can gain, and the order in which they are sampled.
 
 Two ceilings on the log Bayes factor of the nested model plus one effect against the nested
-model, both from the candidate's posterior mode (``baseline.fit_map``; sigma^2 = SSE / n
-maximises eq. (10) over sigma) under the same tempered likelihood (``baseline.ChainProblem``)
+model, both from the candidate's posterior mode (``map_fit.fit_map``; sigma^2 = SSE / n
+maximises eq. (10) over sigma) under the same tempered likelihood (``map_fit.ChainProblem``)
 as the nested model's sampled evidence:
 
 * strict: for a prior that integrates to one, Z = int L pi <= max L, so the gain is at most
@@ -29,7 +29,7 @@ of the added parameters and, for a start shape (a mode's frequency), the detecti
 fit below the nested model's best (impossible at the optimum of a model that contains the
 nested one; possible where the added term's smallest admissible size already costs, as for a
 log-uniform amplitude) is marked ``failed``, and its bound is not used. Each candidate's
-Laplace log evidence (``baseline.laplace_log_evidence``) minus the nested model's is reported
+Laplace log evidence (``map_fit.laplace_log_evidence``) minus the nested model's is reported
 beside it.
 
 The bound ignores the added parameters' Occam factor, so it cannot rule out a candidate
@@ -118,7 +118,7 @@ class Screened:
     importance_trusted: bool = False  # reliable, and the round's check of the nested passed
     #: makes the estimate on first use (:meth:`importance_ceiling`); None once made
     pending: Callable[[], None] | None = field(default=None, repr=False)
-    #: added parameters whose MAP lies on a bound of their prior (``baseline.bound_pull``):
+    #: added parameters whose MAP lies on a bound of their prior (``map_fit.bound_pull``):
     #: {name: (side, nats the posterior falls over EDGE_SHARE of the width from it)}
     on_bound: dict[str, tuple[str, float]] = field(default_factory=dict)
     #: the candidate's problem and priors, as its fit and its estimate used them

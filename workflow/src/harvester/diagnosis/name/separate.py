@@ -8,7 +8,7 @@ neither alone; it says what each would mean and which experiment would decide be
 For a proposed excitation u (the recording's own at twice and at half its amplitude, and a
 logarithmic sine sweep over the analysed band at its RMS level) and a candidate A taken as
 the truth: A's posterior-mean response to u is the noise-free data, the rival B is refitted to
-it (its MAP in its prior coordinates, started from its posterior mean, ``baseline.fit_map``),
+it (its MAP in its prior coordinates, started from its posterior mean, ``map_fit.fit_map``),
 and what B cannot follow is the evidence A would gain on such a recording,
 
     gap_A(u) = lambda sum_t (y_A(t) - y_B*(t))^2 / (2 sigma^2)      (nats),

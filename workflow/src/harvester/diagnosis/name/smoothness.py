@@ -10,7 +10,7 @@ runs to its cap, the chains disagree by tens of nats, and the evidence is not es
 frame at 250 g: 27 min of TMCMC for one such candidate; docs/measurements.md).
 
 The check (:func:`smoothness`): along each principal axis of the MAP's Laplace covariance
-in the prior coordinates (``baseline.PriorCoordinates``), the directions and the scales of
+in the prior coordinates (``map_fit.PriorCoordinates``), the directions and the scales of
 the random walk's proposals, the profiled log-likelihood at the MAP and at PROBES times the
 axis's standard deviation from it (shortened to stay inside the prior's support; a point
 whose simulation fails is a wall, as a bound, and left out), a quadratic fitted through
@@ -82,7 +82,7 @@ def smoothness(problem, specs: Mapping[str, PriorSpec], point: PointFit,
     ``point`` under the priors ``specs``; ``parameter`` names the axis by the parameter that
     weighs most in it. Axes led by a parameter of ``on_bound`` (whose MAP lies on a bound
     of its prior: ``Screened.on_bound``) are left out: the fall towards the bound is the
-    bound's check (``baseline.bound_pull``), and along it the Laplace scale means nothing
+    bound's check (``map_fit.bound_pull``), and along it the Laplace scale means nothing
     (the Dahl record's c_hyst fell 5000 nats within 0.06 sd of its MAP, a wall, and its
     TMCMC mixed)."""
     clock = time.perf_counter()

@@ -75,7 +75,7 @@ def decide_verdict(p_value: float, accepted: bool, unexplained_alpha: float, *,
     acceptance is calibrated by itself (``confirm``: P(B > 1/alpha) <= alpha under the
     baseline), so the false-alarm rate is at most P(accepted) + unexplained_alpha. The
     detection's p-value reaches below 1 / (bootstrap + 1) by its replicates' tail
-    (``tail.py``), so ``unexplained_alpha`` is reachable at any number of replicates. The
+    (``inference.tail``), so ``unexplained_alpha`` is reachable at any number of replicates. The
     floor and the share explained do not rest on the replicates, which take the residual's own
     level: a residual that is the whole signal cannot hide in them.
     """
@@ -361,7 +361,7 @@ def _named(found: Conclusion, missing: MissingForce | None, units: Units = SI) -
     fit, their own forces summed with their interval (``missing_force.together_force``);
     several effects' (or one without that) is the
     improved model's force beyond the baseline's along the smoothed states
-    (``latent_views.effect_force``), theirs together, said once. Along states uncertain by
+    (``views.effect_force``), theirs together, said once. Along states uncertain by
     millimetres an impact term's force is not its own: a named end stop read 9.97 N RMS
     there (371 % of the drive) and 0.189 N along its own response. Labelled in ``units``; a
     named effect's strength is read from the last round that named one (``named_fit``)."""

@@ -1,5 +1,5 @@
 """Figures of the missing force (``latent``), its shape (``shapes``) and a named effect's force
-beside it (``latent_views.effect_force``), in the project's style: the force estimated from
+beside it (``views.effect_force``), in the project's style: the force estimated from
 the recording in grey with its +-2 sd band shaded, the model (a fitted shape, a term's force)
 in black, every axis labelled with its unit."""
 

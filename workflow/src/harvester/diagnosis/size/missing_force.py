@@ -1,7 +1,7 @@
 """The missing force in one call, for the diagnosis run and its diagnosis.json: the latent force
-of the baseline (``latent``), its shape (``shapes``), its views (``latent_views``), each named
+of the baseline (``latent``), its shape (``shapes``), its views (``views``), each named
 effect's force beside it with its size and relevance (``relevance``), a line the force leaves
-in the recording (``lines``), and the figures (``latent_figures``)."""
+in the recording (``lines``), and the figures (``figures``)."""
 
 from __future__ import annotations
 

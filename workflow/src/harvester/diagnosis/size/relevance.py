@@ -3,7 +3,7 @@ the device's forces, the share of the missing force it explains, the change it m
 predicted response on unseen data, and a floor of relevance below which it is "detectable but
 negligible" rather than missing physics.
 
-Sizes, along the latent force's smoothed states (``latent_views.effect_force``):
+Sizes, along the latent force's smoothed states (``views.effect_force``):
 
     force_rms        RMS of dF, the improved model's force beyond the baseline's (N, or the
                      recording's force unit: ``units``, ``data.units``)

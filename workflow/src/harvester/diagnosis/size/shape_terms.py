@@ -19,7 +19,7 @@ motion, so the fit starts from a grid (:func:`period_grid`: half a period over t
 span apart, phases and two amplitudes) evaluated in one batch of simulations, its best rows
 refined in the phase and the amplitude (:func:`_refined`), and the MAP is solved from the
 best of those. The result is its Laplace log evidence over the baseline's
-(``baseline.laplace_log_evidence``) and, where the diagnosis named effects, the improved
+(``map_fit.laplace_log_evidence``) and, where the diagnosis named effects, the improved
 model's by the same measure, so that the two are compared in one currency
 (``verdict.withheld_names``).
 """

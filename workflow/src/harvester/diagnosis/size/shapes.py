@@ -121,7 +121,7 @@ class ShapeDescription:
     def share_of(self, banded: np.ndarray) -> float:
         """The share of the missing force a force explains, as each shape's is read: less
         its mean, within the determined band (``banded``: already through the latent
-        force's band, as ``latent_views.effect_force`` gives a named effect's)."""
+        force's band, as ``views.effect_force`` gives a named effect's)."""
         g = self.mask(banded - np.mean(banded))
         return _share(self.force, g)
 
