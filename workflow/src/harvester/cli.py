@@ -175,6 +175,8 @@ def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="harvester", description=__doc__.split("\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
                                 epilog=RECORDING_HELP)
+    from harvester import __version__
+    p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     _recording_args(_command(sub, "check"), out=False)
     i = _command(sub, "identify")

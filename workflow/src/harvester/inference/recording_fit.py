@@ -137,6 +137,11 @@ class Fit:
     priors: dict[str, PriorSpec]
     evidence: dict
 
+    def summary(self) -> pd.DataFrame:
+        """Each parameter's mean, sd and 95 % interval with its unit (:func:`parameter_table`,
+        the run's summary.csv)."""
+        return parameter_table(self.idata, self.priors)
+
 
 def load_fit(directory: Path, problem: Problem, priors: dict[str, PriorSpec]) -> Fit | None:
     """A finished run in ``directory`` (evidence.json and posterior.nc), or None."""
