@@ -62,7 +62,8 @@ def test_import_is_light_and_names_resolve() -> None:
 
 
 def test_version_is_pyproject_s() -> None:
-    """``harvester.__version__`` and ``harvester --version`` give pyproject.toml's version."""
+    """``harvester.__version__``, ``harvester --version`` and CITATION.cff give pyproject.toml's
+    version."""
     import harvester
     stated = re.search(r'(?m)^version\s*=\s*"([^"]+)"',
                        (ROOT / "pyproject.toml").read_text()).group(1)
@@ -70,6 +71,8 @@ def test_version_is_pyproject_s() -> None:
     proc = subprocess.run([str(Path(sys.executable).with_name("harvester")), "--version"],
                           capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0 and proc.stdout.strip() == f"harvester {stated}"
+    cited = re.search(r"(?m)^version: (\S+)$", (ROOT / "CITATION.cff").read_text()).group(1)
+    assert cited == stated, "CITATION.cff's version is not pyproject.toml's"
 
 
 def test_python_defaults_are_the_command_line_s() -> None:
