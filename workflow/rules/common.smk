@@ -14,7 +14,7 @@ ENV = "../../envs/harvester.yaml"
 # Threads of a rule that integrates many models (TMCMC, predictive bounds, diagnosis): one.
 # The study has many such jobs that do not wait on each other, and two one-thread jobs on two
 # cores finished in 0.78x the time of the same two jobs one after the other on two threads each
-# (docs/measurements.md, "The study's time"); with more cores, more jobs run at once.
+# (docs/measurements.md, "The study and the test suite"); with more cores, more jobs run at once.
 JOB_THREADS = 1
 
 # ---------------------------------------------------------------- the paper study's records

@@ -173,6 +173,8 @@ def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="harvester", description=__doc__.split("\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
                                 epilog=RECORDING_HELP)
+    from harvester import __version__
+    p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     _recording_args(_command(sub, "check"), out=False)
     i = _command(sub, "identify")
@@ -284,23 +286,6 @@ def _read(path: Path, paper_device: bool, accept=None, known=None, known_from=No
     return dev.checked, dev.known
 
 
-def _lowpass(args: argparse.Namespace, checked) -> tuple[float | None, str]:
-    """The zero-phase low-pass the recording went through (Hz or None) and where it is from."""
-    from harvester.diagnosis.detect.spectral import recording_lowpass
-    if args.filtered_at is not None:
-        return (args.filtered_at or None), "--filtered-at"
-    if checked.sidecar.filtered_at_hz is not None:
-        return (checked.sidecar.filtered_at_hz or None), \
-            f"filtered_at_hz in {checked.sidecar.path}"
-    df = checked.data
-    found, shared = recording_lowpass(None, df[checked.kinds.input_kind].to_numpy(),
-                                      df[checked.kinds.output_kind].to_numpy(), 1.0 / checked.dt)
-    if shared:
-        log.warning("%s: %s", checked.sidecar.path, shared)
-    return found, ("found from the output's spectrum (give --filtered-at to override)"
-                   if found else "none found in the output's spectrum")
-
-
 def _record(command: str, args: argparse.Namespace, checked, kp) -> dict:
     """What run.json says about the input: recording, kinds, sidecar, known and assumed."""
     from harvester.data.daq import sha256
@@ -363,25 +348,14 @@ def check_command(args: argparse.Namespace) -> int:
 
 
 def _prepare_fit(args: argparse.Namespace, model: str, checked, kp):
-    """(problem, priors, notes) of one structure on the checked recording."""
-    from harvester.inference.recording_fit import FitWindow, recording_problem
-    from harvester.initial.recording import identification_priors
-    lowpass, where = _lowpass(args, checked)
-    window = FitWindow(args.lead_in, lowpass, args.filter_order, args.fit_seconds)
-    hint = f", in {checked.sidecar.path}, or pass --paper-device"
-    problem = recording_problem(checked.data, model, kp.values, window, str(args.recording),
-                                hint)
-    try:
-        priors, notes = identification_priors(
-            checked.data, problem.structure.free_parameters, problem.known,
-            checked.sidecar.priors, lowpass, str(args.recording))
-    except KeyError as err:  # a prior in the sidecar for a parameter the library lacks
-        raise DataError(checked.sidecar.path, str(err.args[0])) from None
-    notes = [f"output low-pass: {f'{lowpass:.3g} Hz' if lowpass else 'none'} ({where})",
-             f"{model}: identified {', '.join(problem.parameter_names)}; held "
-             + (", ".join(f"{k} = {v:g}" for k, v in problem.known.items()
-                          if not (k == "m" and problem.input_kind == "force")) or "none"),
-             *notes]
+    """(problem, priors, notes) of one structure on the checked recording (``api.fit_problem``,
+    the one preparation of the command line and of ``harvester.identify``)."""
+    from harvester.api import fit_problem
+    problem, priors, notes = fit_problem(
+        checked, model, kp.values, lead_in_s=args.lead_in, lowpass_hz=args.filtered_at,
+        filter_order=args.filter_order, fit_seconds=args.fit_seconds,
+        source=str(args.recording), hint=f", in {checked.sidecar.path}, or pass --paper-device",
+        option="--filtered-at")
     for note in notes:
         log.info("%s", note)
     return problem, priors, notes

@@ -56,16 +56,26 @@ def read_device_recording(path: str | Path, defaults: Mapping[str, float] | None
     kinds a command takes; ``for_model``: rewrite a ``friction_on: ground`` device in the
     ground's coordinates, without the screw-side mass m (the form every fit and prediction
     sees). DataError (file, line or column) for a bad recording or sidecar."""
-    from harvester.data.kinds import on_ground
-    from harvester.data.recording import recording_kinds
     sidecar = read_sidecar(path)
     kp = resolve_known(sidecar, defaults, defaults_from)
     values = kp.values if known is None else known
     checked = read_checked_recording(path, values, known_from or kp.source, accept=accept)
-    if not (for_model and sidecar.friction_on == "ground"):
+    return model_form(checked, kp, str(path), values) if for_model else \
+        DeviceRecording(checked, kp)
+
+
+def model_form(checked: CheckedRecording, kp: KnownParameters, source: str,
+               values: Mapping[str, float] | None = None) -> DeviceRecording:
+    """The checked recording (read from ``source``) as a model sees it: as read, or, where
+    its sidecar says ``friction_on: ground``, rewritten in the ground's coordinates with the
+    device ``values`` (default ``kp``'s), without the screw-side mass m (``kinds.on_ground``,
+    the one place of that rewrite)."""
+    if checked.sidecar.friction_on != "ground":
         return DeviceRecording(checked, kp)
-    df, values, done = on_ground(checked.data, values, str(path))
-    checked = replace(checked, data=df, kinds=recording_kinds(df, path))
+    from harvester.data.kinds import on_ground
+    from harvester.data.recording import recording_kinds
+    df, _, done = on_ground(checked.data, kp.values if values is None else values, source)
+    checked = replace(checked, data=df, kinds=recording_kinds(df, source))
     kp = replace(kp, values={k: v for k, v in kp.values.items() if k != "m"},
                  given={k: v for k, v in kp.given.items() if k != "m"})
     return DeviceRecording(checked, kp, list(done))

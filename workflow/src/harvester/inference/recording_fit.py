@@ -137,6 +137,11 @@ class Fit:
     priors: dict[str, PriorSpec]
     evidence: dict
 
+    def summary(self) -> pd.DataFrame:
+        """Each parameter's mean, sd and 95 % interval with its unit (:func:`parameter_table`,
+        the run's summary.csv)."""
+        return parameter_table(self.idata, self.priors)
+
 
 #: Draws a fit's figure in a directory and returns its file name (the inference layer writes
 #: no figure itself: ``harvester.plots.posterior.fit_pair_figure``).
