@@ -473,17 +473,22 @@ def _diagnosis_settings(args: argparse.Namespace):
 
 def diagnose_command(args: argparse.Namespace) -> int:
     from harvester.data.fileio import atomic_directory, check_output_dir
-    from harvester.diagnosis import diagnose_recording, write
+    from harvester.diagnosis.prepare.recording import diagnosis_input
+    from harvester.diagnosis.run import diagnose_given, write
     from harvester.study.paper import TABLE1_KNOWN
 
     check_output_dir(args.out, inputs=tuple(p for p in (args.recording, args.validation) if p))
+    given = diagnosis_input(  # the library's decisions, as harvester.diagnose makes them
+        args.recording, args.baseline, validation=args.validation,
+        settings=_diagnosis_settings(args), lowpass_output_hz=args.lowpass,
+        defaults=TABLE1_KNOWN if args.paper_device else None,
+        defaults_from="the paper's Table 1 (--paper-device)")
+    if _log_to_file:  # the library logged them; the console hears them once too
+        for w in given.warnings:
+            print(f"harvester: warning: {w}", file=sys.stderr)
     key = _key(args, Path(args.validation) if args.validation else None)
     with atomic_directory(args.out, key) as stage:
-        diag = diagnose_recording(
-            args.recording, args.baseline, validation=args.validation,
-            settings=_diagnosis_settings(args), lowpass_output_hz=args.lowpass,
-            defaults=TABLE1_KNOWN if args.paper_device else None,
-            defaults_from="the paper's Table 1 (--paper-device)")
+        diag = diagnose_given(given, args.baseline)
         write(diag, stage)
     print(f"{diag.headline} -> {args.out / 'diagnosis.json'}")
     return 0

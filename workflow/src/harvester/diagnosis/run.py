@@ -37,7 +37,7 @@ from harvester.diagnosis.name.verdict import (Conclusion, FitJudgement, Tie, con
 from harvester.diagnosis.prepare.analysis import (Analysis, BaselineStart, check_recording,
                                                   default_priors, prepare, resample_for_model,
                                                   start_baseline, velocity_bound)
-from harvester.diagnosis.prepare.recording import diagnosis_input
+from harvester.diagnosis.prepare.recording import DiagnosisInput, diagnosis_input
 from harvester.diagnosis.prepare.settings import DiagnosisSettings
 from harvester.diagnosis.report.document import UnseenFit
 from harvester.diagnosis.report.unseen import fit_judgement, unseen_comparison
@@ -152,6 +152,14 @@ def diagnose_recording(recording: str | Path, baseline: str, *,
     given = diagnosis_input(recording, baseline, validation=validation, settings=settings,
                             lowpass_output_hz=lowpass_output_hz, defaults=defaults,
                             defaults_from=defaults_from)
+    return diagnose_given(given, baseline, out_dir)
+
+
+def diagnose_given(given: DiagnosisInput, baseline: str,
+                   out_dir: str | Path | None = None) -> Diagnosis:
+    """The diagnosis of a recording's file once its input is decided
+    (``prepare.recording.diagnosis_input``; the command line decides it first, so that bad
+    input is refused before anything is written): its notes open the diagnosis's."""
     diag = diagnose(given.recording, baseline, given.known, given.priors,
                     validation=given.validation, settings=given.settings,
                     source=given.source)
