@@ -159,3 +159,40 @@ def test_a_name_that_explains_nothing_of_what_is_missing_is_not_relevant() -> No
     small = EffectSize("inertia_error", 1e-4, 1e-4, 0.0, 1e-4, 1e-4, True, RelevanceFloor())
     explains_little([small], None)
     assert not small.little and small.label == "detectable but negligible"
+
+
+def _mass_error_map(name: str, seed: int, k_scale: float = 1.0, seconds: float = 8.0):
+    """The implied device of tanh + inertia_error fitted by MAP (Laplace draws) to the
+    literature generator's record at 1 x the noise RMS, its sidecar's k scaled by
+    ``k_scale`` (a spring mis-stated: the generator has no stiffness error of its own)."""
+    from harvester.diagnosis.analysis import default_priors
+    from harvester.diagnosis.baseline import chain_problem, fit_map
+    from harvester.inference.problems import make_problem
+    from harvester.synthetic.literature import generate
+    g = generate(name, seed=seed, ratio=1.0)
+    known = {**g.sidecar, "k": k_scale * g.sidecar["k"]}
+    fs = 1.0 / float(g.recording.time[1] - g.recording.time[0])
+    rec = g.recording.iloc[:int((1.0 + seconds) * fs)].reset_index(drop=True)
+    s = named_structure("tanh+inertia_error")
+    problem = chain_problem(make_problem(rec, s, known, window=(int(fs), len(rec))), 1.0,
+                            None, 8)
+    priors = {k: v for k, v in default_priors(s, 1.0).items() if k != "sigma"}
+    mp = fit_map(problem, priors, n_starts=8)
+    return implied_device("inertia_error", s, mp.samples(200), known,
+                          measured_device(known)), g
+
+
+@pytest.mark.slow  # two MAP fits with their compilation: 43 s on 2 shared cores
+def test_the_check_on_literature_records_a_true_mass_error_and_a_spring_mis_stated() -> None:
+    """On the literature generator's payload record (seed 0: +0.46 kg on 4.57 kg, 10 %) the
+    fitted mass error's device agrees with the sidecar; on its effect-free record whose
+    sidecar states twice the spring's k, a mass error stands in for the spring (M, m, c and
+    F_c all doubled is the same device), pulls M to twice the stated and is refused."""
+    payload, g = _mass_error_map("payload_error", 0)
+    by = {d.measured.name: d for d in payload}
+    assert all(d.agrees for d in payload)
+    assert by["M"].median == pytest.approx(g.truth["true_masses"]["M"], rel=0.03)
+    spring, g = _mass_error_map("none", 0, k_scale=2.0)
+    by = {d.measured.name: d for d in spring}
+    assert not by["M"].agrees and by["M"].median == pytest.approx(2 * g.sidecar["M"], rel=0.03)
+    assert "acts like a mass but is not one" in by["M"].sentence()
