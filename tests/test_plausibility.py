@@ -196,3 +196,26 @@ def test_the_check_on_literature_records_a_true_mass_error_and_a_spring_mis_stat
     by = {d.measured.name: d for d in spring}
     assert not by["M"].agrees and by["M"].median == pytest.approx(2 * g.sidecar["M"], rel=0.03)
     assert "acts like a mass but is not one" in by["M"].sentence()
+
+
+def test_a_refused_mass_error_is_said_in_the_headline_and_the_notes() -> None:
+    """The rounds' refused candidate (its evidence enough, its device not) is not named: the
+    headline says the furthest contradiction, the notes all of them and its evidence."""
+    from harvester.diagnosis.confirm import CandidateResult
+    from harvester.diagnosis.rounds import Round
+    from harvester.diagnosis.settings import DiagnosisSettings
+    from harvester.diagnosis.verdict import conclude, judge
+    known = {"M": 20.0, "m": 15.0, "k": 2000.0}
+    s, draws = _mass_error_draws(57.2, 0.5)
+    device = implied_device("inertia_error", s, draws, known, measured_device(known))
+    refused = CandidateResult("inertia_error", None, 40.0, 0.2, 6.0, False, device=device)
+    detection = SimpleNamespace(p_value=1e-6, significant=True, conflict=False)
+    rnd = Round("tanh", detection, None, [], [refused])
+    found = conclude([rnd], True, DiagnosisSettings(), 20.0)
+    assert found.missing == [] and not found.accepted and len(found.refused) == 1
+    assert "oscillating mass to 72.2 kg" in found.refused[0]  # 36 sd, beyond M's 19
+    assert any("+40.0 nats, enough to be accepted" in n and "effective mass" in n
+               for n in found.notes)
+    judged = judge(found, detection, _fit(1.5), "tanh", DiagnosisSettings())
+    assert judged.verdict == "missing_physics"
+    assert "not named: inertia_error: the record's mismatch pulls" in judged.headline

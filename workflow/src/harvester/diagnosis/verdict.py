@@ -231,11 +231,11 @@ def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings
             if r.at_prior_edge:
                 notes.append(f"{r.effect}: the posterior of {', '.join(r.at_prior_edge)} piles "
                              "against its prior's bound; the candidate is not trusted")
-            if r.refused_for_device:
-                refused.append("; ".join(d.sentence() for d in r.contradicted))
-                notes.append(f"{refused[-1]} ({r.effect} gained {r.delta_log_evidence:+.1f} "
-                             "nats, enough to be accepted): not named, the next candidates "
-                             "were tried")
+            if r.refused_for_device:  # the headline says the furthest out, the notes all
+                refused.append(max(r.contradicted, key=lambda d: d.z).sentence())
+                notes.append(f"{'; '.join(d.sentence() for d in r.contradicted)} ({r.effect} "
+                             f"gained {r.delta_log_evidence:+.1f} nats, enough to be "
+                             "accepted): not named, the next candidates were tried")
     verdict = decide_verdict(first.p_value, bool(accepted), settings.unexplained_alpha)
     named = [a.fit for a in accepted if a.named]
     return Conclusion(verdict, missing, ties, bool(unexplained), notes,
