@@ -39,6 +39,11 @@ def test_a_sidecar_states_its_uncertainties_or_gets_the_default(tmp_path) -> Non
     (tmp_path / "r.yaml").write_text("M: 20\nM_sd: -1\n")
     with pytest.raises(DataError, match="'M_sd' must be a positive number"):
         read_sidecar(tmp_path / "r.csv")
+    from harvester.diagnosis.settings import DiagnosisSettings
+    (tmp_path / "r.yaml").write_text("M: 20\nm: 15\nM_sd: 0.5\n")
+    settings = DiagnosisSettings().with_sidecar(read_sidecar(tmp_path / "r.csv"))
+    assert settings.device_sd == (("M", 0.5),)
+    assert settings.confirmation().device_sd == (("M", 0.5),)
     measured = measured_device({"M": 20.0, "m": 15.0, "c_m": 4.0}, [("M", 0.5)])
     assert set(measured) == {"M", "m"} and measured["M"].sd == 0.5 and measured["M"].stated_sd
     assert measured["m"].sd == pytest.approx(2.25) and not measured["m"].stated_sd

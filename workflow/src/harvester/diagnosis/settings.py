@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
-from harvester.data.sidecar import DEFAULT_RELATIVE_SD
+from harvester.data.sidecar import DEFAULT_RELATIVE_SD, Sidecar
 from harvester.data.units import SI, Units, read_units
 from harvester.diagnosis.confirm import ConfirmSettings
 from harvester.diagnosis.detect import DetectionSettings
@@ -132,6 +132,11 @@ class DiagnosisSettings:
             values["device_sd"] = tuple((str(k), float(v))
                                         for k, v in dict(values["device_sd"]).items())
         return cls.fast(**values) if cfg.get("fast") else cls(**values)
+
+    def with_sidecar(self, sidecar: Sidecar) -> "DiagnosisSettings":
+        """These settings with what a recording's sidecar states of them: its units and the
+        uncertainties of its M, m, k (``M_sd``...; ``plausibility``)."""
+        return replace(self, units=sidecar.units, device_sd=tuple(sidecar.known_sd.items()))
 
     def detection(self) -> DetectionSettings:
         return DetectionSettings(bootstrap=self.bootstrap, alpha=self.alpha,
