@@ -361,7 +361,7 @@ def on_ground(df: pd.DataFrame, known: Mapping[str, float], source: str = "<reco
         raise DataError(source, f"friction_on: ground with a {inp.name} input needs the "
                         f"base's displacement y (the force k y drives the mass in absolute "
                         f"coordinates), and the double integral of {inp.symbol} does not fix "
-                        "it: on two sines (1.1 and 4.7 Hz, 10 s) it was off by 34-230 % of "
+                        "it: on two sines (1.1 and 4.7 Hz, 10 s) it was off by 35-231 % of "
                         "y's RMS for high-passes at 0.8-0.1 Hz; record the base's "
                         "displacement (base_disp), or give friction_on: base",
                         column=inp.name)
