@@ -523,7 +523,7 @@ def test_a_failed_fit_is_sampled_only_where_a_trusted_importance_estimate_leaves
     assert "single effects' scores" in skip_reason(stop, [], cs, 3, single_scores=True)
     # nor once another candidate is accepted
     from types import SimpleNamespace
-    mode = SimpleNamespace(effect="unmodelled_mode", accepted=True)
+    mode = SimpleNamespace(effect="unmodelled_mode", accepted=True, contradicted=[])
 
     def estimate():
         raise AssertionError("estimated after another candidate was accepted")

@@ -303,7 +303,7 @@ def test_a_noisy_base_displacement_without_its_low_pass_is_a_warning() -> None:
 
 def test_friction_on_the_ground_from_the_sidecar(tmp_path) -> None:
     """The sidecar's friction_on: ground rewrites base_disp -> rel_disp in absolute
-    coordinates (force k y, output x = z + y); a bad value or another kind is refused."""
+    coordinates (force k y, output x = z + y); a bad value is refused."""
     from harvester.data.kinds import on_ground
     from harvester.data.sidecar import read_sidecar
     t, y, _, _ = _sines()
@@ -313,8 +313,6 @@ def test_friction_on_the_ground_from_the_sidecar(tmp_path) -> None:
     assert np.allclose(out.force, 1000.0 * (y - y.mean()))
     assert np.allclose(out.rel_disp, 0.5 * y - np.mean(0.5 * y))
     assert "friction on the ground" in notes[0]
-    with pytest.raises(DataError, match="needs base_disp and rel_disp"):
-        on_ground(df.rename(columns={"base_disp": "base_acc"}), {"k": 1.0})
     with pytest.raises(DataError, match="needs k known"):
         on_ground(df, {"M": 3.0})
     (tmp_path / "r.yaml").write_text("k: 1000\nfriction_on: ground\n")
@@ -322,6 +320,37 @@ def test_friction_on_the_ground_from_the_sidecar(tmp_path) -> None:
     (tmp_path / "r.yaml").write_text("k: 1000\nfriction_on: storey\n")
     with pytest.raises(DataError, match="line 2.*'friction_on' must be base or ground"):
         read_sidecar(tmp_path / "r.csv")
+
+
+def test_friction_on_the_ground_with_a_force_input_is_the_recording_itself() -> None:
+    """With a force input the base is fixed: the ground is the base, and the recording (any
+    output) comes back unchanged, known and all (it was refused before: issue 63)."""
+    from harvester.data.kinds import on_ground
+    t, y, _, a = _sines()
+    for out_kind, x in (("rel_acc", a), ("rel_disp", y)):
+        df = pd.DataFrame({"time": t, "force": 40.0 * y, out_kind: x})
+        out, known, notes = on_ground(df, {"M": 3.0, "m": 2.0, "k": 1000.0}, "rec.csv")
+        pd.testing.assert_frame_equal(out, df)
+        assert known == {"M": 3.0, "m": 2.0, "k": 1000.0} and "base is fixed" in notes[0]
+
+
+def test_friction_on_the_ground_with_an_acceleration_output() -> None:
+    """base_disp -> rel_acc: the same force k y as base_disp -> rel_disp, and the output
+    x'' = z'' + y'' with y'' differentiated from the base's displacement (exact inside the
+    record); a base acceleration is refused with what its double integral misses."""
+    from harvester.data.kinds import on_ground
+    t, y, _, a = _sines()
+    known = {"M": 3.0, "m": 3.0, "k": 1000.0}
+    ref, _, _ = on_ground(pd.DataFrame({"time": t, "base_disp": y, "rel_disp": -0.5 * y}),
+                          known)
+    out, k, notes = on_ground(pd.DataFrame({"time": t, "base_disp": y, "rel_acc": -0.5 * a}),
+                              known, "rec.csv", lowpass_hz=20.0)
+    assert list(out.columns) == ["time", "force", "rel_acc"] and "m" not in k
+    assert np.allclose(out.force, ref.force) and "x'' = rel_acc + y''" in notes[0]
+    inner = slice(250, -250)
+    assert np.max(np.abs(out.rel_acc - 0.5 * a)[inner]) < 1e-6 * np.std(a)
+    with pytest.raises(DataError, match="base_acc input needs the base's displacement"):
+        on_ground(pd.DataFrame({"time": t, "base_acc": a, "rel_acc": -0.5 * a}), known)
 
 
 def test_every_fitting_command_reads_a_ground_device_alike(tmp_path) -> None:

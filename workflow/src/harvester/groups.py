@@ -343,10 +343,10 @@ def diagnose_model(data: str | Path, validation: str | Path | None, posterior: s
                                                       checked.sidecar)
     unseen = None if validation is None else \
         read_checked_recording(validation, known=known, known_from=str(priors_file)).data
-    diag_settings = replace(DiagnosisSettings.from_config(settings["diagnosis"]),
+    diag_settings = replace(DiagnosisSettings.from_config(settings["diagnosis"])
+                            .with_sidecar(checked.sidecar),  # its units, its M_sd...
                             lowpass_hz=checked.sidecar.filtered_at_hz,
-                            filter_order=int(settings["filter_order"]),
-                            units=checked.sidecar.units)
+                            filter_order=int(settings["filter_order"]))
     lead_in, samples = window_samples(settings, 1.0 / checked.dt)
     if unseen is None:  # the diagnosis holds out the record's end, which no fit has seen
         samples = None

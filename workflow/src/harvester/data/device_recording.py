@@ -69,13 +69,15 @@ def model_form(checked: CheckedRecording, kp: KnownParameters, source: str,
     """The checked recording (read from ``source``) as a model sees it: as read, or, where
     its sidecar says ``friction_on: ground``, rewritten in the ground's coordinates with the
     device ``values`` (default ``kp``'s), without the screw-side mass m (``kinds.on_ground``,
-    the one place of that rewrite)."""
+    the one place of that rewrite; with a force input the recording is as read, the base
+    being the ground)."""
     if checked.sidecar.friction_on != "ground":
         return DeviceRecording(checked, kp)
     from harvester.data.kinds import on_ground
     from harvester.data.recording import recording_kinds
-    df, _, done = on_ground(checked.data, kp.values if values is None else values, source)
+    df, kept, done = on_ground(checked.data, kp.values if values is None else values, source)
     checked = replace(checked, data=df, kinds=recording_kinds(df, source))
-    kp = replace(kp, values={k: v for k, v in kp.values.items() if k != "m"},
-                 given={k: v for k, v in kp.given.items() if k != "m"})
+    unused = {k for k in ("m",) if k not in kept}  # m, where the rewrite leaves it out
+    kp = replace(kp, values={k: v for k, v in kp.values.items() if k not in unused},
+                 given={k: v for k, v in kp.given.items() if k not in unused})
     return DeviceRecording(checked, kp, list(done))

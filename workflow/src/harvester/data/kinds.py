@@ -20,9 +20,9 @@ Input kinds the model cannot take as they are (``base_disp``) are converted to o
 by :func:`model_recording`; the recording passed in is never changed (a converted copy is
 returned, the conversion stated in its notes). :func:`paper_case` reads any recording as the
 paper's base_acc -> rel_acc case for the methods written for it (the FRF damping fit of the
-priors); :func:`on_ground` rewrites a base_disp -> rel_disp recording of a device whose
-friction acts on the mass's own velocity (the sidecar's ``friction_on: ground``) in absolute
-coordinates.
+priors); :func:`on_ground` rewrites a base-driven recording of a device whose friction acts
+on the mass's own velocity (the sidecar's ``friction_on: ground``) in absolute coordinates,
+and takes a force-driven one as it is (its base is the ground).
 
 A displacement is differentiated in the frequency domain: the line joining its end points is
 removed (a straight line has no acceleration), the record is extended by its odd reflection at
@@ -331,32 +331,57 @@ def paper_case(df: pd.DataFrame, known: Mapping[str, float], lowpass_hz: float |
                          "rel_acc": y}), known
 
 
-def on_ground(df: pd.DataFrame, known: Mapping[str, float], source: str = "<recording>"
+def on_ground(df: pd.DataFrame, known: Mapping[str, float], source: str = "<recording>",
+              lowpass_hz: float | None = None
               ) -> tuple[pd.DataFrame, dict[str, float], list[str]]:
     """(recording, known, notes) of a device whose friction acts on the mass's own velocity
-    (a contact fixed to the ground; the sidecar's ``friction_on: ground``): a base_disp ->
-    rel_disp recording rewritten in absolute coordinates, where eq. (1) with m = M,
+    (a contact fixed to the ground; the sidecar's ``friction_on: ground``).
+
+    A force input: the base is fixed, so the ground is the base and the relative velocity
+    the mass's own; the recording is returned as it is (a copy), whatever its output.
+
+    A base displacement: rewritten in absolute coordinates, where eq. (1) with m = M,
     M x'' + c (x' - y') + k (x - y) + F_f(x') = 0, is M x'' + c x' + k x + F_f(x') =
     k y + c y': driven by the force F = k y (N; the c y' part is left out, as the model's c_m
-    is identified) with the output x = z + y (m), so that every friction term acts on x'.
-    Needs k known; m is then unused (and M = m is assumed: a frame, not a screw). DataError
-    for other kinds. A copy; the recording passed in is not changed."""
+    is identified) with the output x = z + y (m, about its mean) or x'' = z'' + y'' (m/s^2,
+    y'' by :func:`derivative` at ``lowpass_hz``, None: the chain's cut-off), so that every
+    friction term acts on x'. Needs k known; m is then unused (and M = m is assumed: a
+    frame, not a screw). A base acceleration is refused: y, its double integral, is not
+    fixed by the record (the error's message gives what was measured). A copy; the
+    recording passed in is not changed."""
     from harvester.data.errors import DataError
     from harvester.data.recording import recording_kinds
     kinds = recording_kinds(df, source)
-    if (kinds.input_kind, kinds.output_kind) != ("base_disp", "rel_disp"):
-        raise DataError(source, f"friction_on: ground needs base_disp and rel_disp (the "
-                        f"mass's absolute displacement is their sum), this recording has "
-                        f"{kinds.input_kind} and {kinds.output_kind}", column=kinds.input_kind)
+    inp, out_kind = input_kind(kinds.input_kind), output_kind(kinds.output_kind)
+    if inp.force_input:
+        return df.copy(), dict(known), [
+            f"{source}: friction on the ground (sidecar friction_on) with a force input: the "
+            "base is fixed, so the friction acts on the mass's velocity, the model's z'"]
+    if inp.order != 0:
+        raise DataError(source, f"friction_on: ground with a {inp.name} input needs the "
+                        f"base's displacement y (the force k y drives the mass in absolute "
+                        f"coordinates), and the double integral of {inp.symbol} does not fix "
+                        "it: on two sines (1.1 and 4.7 Hz, 10 s) it was off by 35-231 % of "
+                        "y's RMS for high-passes at 0.8-0.1 Hz; record the base's "
+                        "displacement (base_disp), or give friction_on: base",
+                        column=inp.name)
     if "k" not in known:
         raise DataError(source, "friction_on: ground needs k known (the force k y drives the "
                         "mass in absolute coordinates): give k in the sidecar")
-    y = df["base_disp"].to_numpy(dtype=float)
-    x = df["rel_disp"].to_numpy(dtype=float) + y
-    out = pd.DataFrame({"time": df["time"].to_numpy(dtype=float),
-                        "force": float(known["k"]) * (y - np.mean(y)), "rel_disp": x - np.mean(x)})
+    t = df["time"].to_numpy(dtype=float)
+    y = df[inp.name].to_numpy(dtype=float)
+    rel = df[out_kind.name].to_numpy(dtype=float)
+    if out_kind.order == 0:
+        x = rel + y
+        x = x - np.mean(x)
+    else:  # x'' = z'' + y''
+        x = rel + derivative(y, float(np.median(np.diff(t))), 2, lowpass_hz)
+    out = pd.DataFrame({"time": t, "force": float(known["k"]) * (y - np.mean(y)),
+                        out_kind.name: x})
     known = {p: v for p, v in known.items() if p != "m"}
+    what = ("x = rel_disp + base_disp (m, about its mean)" if out_kind.order == 0 else
+            "x'' = rel_acc + y'' (y'' differentiated from base_disp)")
     note = (f"{source}: friction on the ground (sidecar friction_on): driven by the force "
-            f"k y (k = {known['k']:g} N/m, RMS {np.std(out.force):.4g} N) with the output "
-            "x = rel_disp + base_disp (m, about its mean), so that friction acts on x'")
+            f"k y (k = {known['k']:g} N/m, RMS {np.std(out.force):.4g} N) with the "
+            f"output {what}, so that friction acts on x'")
     return out, known, [note]

@@ -18,7 +18,10 @@ is TMCMC's re-estimated by bridge sampling from the final population (``bridge_e
 whose standard error is its own; chains that disagree by more than ``agreement_nats`` are
 sampled again with twice the particles. Naming (``mark_ties``): the best accepted candidate is
 named only if every physically different rival trails it by more than log(1/alpha) plus its
-Monte Carlo margin; otherwise they are reported together as a tie.
+Monte Carlo margin; otherwise they are reported together as a tie. A candidate whose
+posterior implies a device the sidecar contradicts (``plausibility``: a mass error that pulls
+M to three times the weighed mass) is not accepted, does not count among the ``top`` sampled
+(the next is sampled in its place) and ties with none: the sidecar tells it apart.
 
 Priors of the added terms: each parameter's prior as its term file states it, in the
 device's own scales (``harvester.model.priors``: the damping force the motion shows, its RMS
@@ -57,6 +60,9 @@ from harvester.diagnosis.detect.scores import Detection, at_prior_edge
 from harvester.diagnosis.name.fits import (BRIDGE_MIN_SE, MISSED_MODE_NATS, ModelFit, candidate_priors,
                                       prior_dict, scan_factor)
 from harvester.diagnosis.name.screen import Screen
+from harvester.data.sidecar import DEFAULT_RELATIVE_SD
+from harvester.diagnosis.name.plausibility import (Implied, contradictions, implied_device,
+                                              measured_device)
 from harvester.diagnosis.detect.signatures import candidate_terms
 from harvester.diagnosis.name.smoothness import smoothness
 from harvester.model.priors import DeviceScale
@@ -101,6 +107,10 @@ class ConfirmSettings(TMCMCSettings):
     family: the number of candidates the round could name (its acceptance shares alpha among
     them, ``acceptance_base``). With 1 (per candidate), an effect-free record of the literature
     grid named an offset force at +3.4 nats against a threshold of 3.3, among 11 candidates.
+
+    device_sd, device_relative_sd: the uncertainty of the stated device (the sidecar's M_sd,
+    m_sd, k_sd as (name, sd) pairs; else the relative sd of the value) that a candidate's
+    implied device is held against (``plausibility``).
     """
 
     particles: int = 300
@@ -114,6 +124,8 @@ class ConfirmSettings(TMCMCSettings):
     alpha: float = 0.05
     mc_sigmas: float = 2.0
     family: int = 1
+    device_sd: tuple[tuple[str, float], ...] = ()
+    device_relative_sd: float = DEFAULT_RELATIVE_SD
 
     def tmcmc(self, offset: int = 0) -> TMCMCSettings:
         """The sampler's settings alone, the seed moved by ``offset``."""
@@ -145,6 +157,20 @@ class CandidateResult:
     indistinguishable_from: list[str] = field(default_factory=list)
     #: added parameters whose posterior piles against a bound of their prior ('lower'/'upper')
     at_prior_edge: dict[str, str] = field(default_factory=dict)
+    #: the stated device quantities its posterior implies (``plausibility``)
+    device: list[Implied] = field(default_factory=list)
+
+    @property
+    def contradicted(self) -> list[Implied]:
+        """The implied quantities that contradict the sidecar (then it is not accepted)."""
+        return contradictions(self.device)
+
+    @property
+    def refused_for_device(self) -> bool:
+        """Whether its evidence would have accepted it but its implied device contradicts the
+        sidecar."""
+        return bool(self.contradicted) and not self.at_prior_edge \
+            and self.delta_log_evidence > self.threshold
 
     @property
     def named(self) -> bool:
@@ -169,6 +195,8 @@ class CandidateResult:
                 "accepted": self.accepted, "named": self.named,
                 "indistinguishable_from": self.indistinguishable_from,
                 "at_prior_edge": self.at_prior_edge, "implies": self.implies(),
+                "device": [d.to_dict() for d in self.device],
+                "device_agrees": not self.contradicted,
                 "parameters": summ,
                 "added_parameters": {n: summ[n] for n in added if n in summ},
                 "added_priors": {n: prior_dict(self.fit.priors[n]) for n in added
@@ -537,7 +565,7 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     None: sample it (always where it was not screened)."""
     if screened is None:
         return None
-    if top is not None and len(results) >= top:
+    if top is not None and len([r for r in results if not r.contradicted]) >= top:
         return f"the round's {top} best by their fits were sampled"
     if screened.pulled and not screened.failed and not any(r.accepted for r in results):
         return (f"its best fit has {screened.pull_phrase()}: its posterior would pile there "
@@ -627,8 +655,23 @@ def judge(effect: str, fit: ModelFit, baseline: ModelFit, settings: ConfirmSetti
     if edges:
         log.warning("%s: the posterior of %s piles against the prior's bound (%s): not trusted",
                     fit.structure.name, ", ".join(edges), ", ".join(edges.values()))
+    device = candidate_device(effect, fit, settings)
+    for d in contradictions(device):
+        log.warning("%s: not named: %s", fit.structure.name, d.sentence())
     return CandidateResult(effect, fit, float(delta), se, float(threshold),
-                           bool(delta > threshold and not edges), at_prior_edge=edges)
+                           bool(delta > threshold and not edges and not contradictions(device)),
+                           at_prior_edge=edges, device=device)
+
+
+def candidate_device(effect: str, fit: ModelFit, settings: ConfirmSettings) -> list[Implied]:
+    """The stated device quantities (the fit's known M, m, k, with ``settings``'
+    uncertainties) that ``effect``'s posterior implies (``plausibility``); none where its
+    term declares none."""
+    if term(effect).device is None:
+        return []
+    known = fit.problem.known
+    return implied_device(effect, fit.structure, fit.samples, known, measured_device(
+        known, settings.device_sd, settings.device_relative_sd))
 
 
 def becomes(result: CandidateResult, effect: str) -> bool:
@@ -650,7 +693,8 @@ def mark_ties(results: list[CandidateResult], settings: ConfirmSettings) -> None
         return
     best = accepted[0]
     for r in results:
-        if r is best or same_physics(r.effect, best.effect) or becomes(r, best.effect):
+        if r is best or same_physics(r.effect, best.effect) or becomes(r, best.effect) \
+                or r.contradicted:  # the sidecar tells it apart
             continue
         gap = best.delta_log_evidence - r.delta_log_evidence
         margin = settings.base_threshold + settings.mc_sigmas * np.hypot(best.delta_se,

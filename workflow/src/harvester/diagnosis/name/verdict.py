@@ -30,7 +30,7 @@ from harvester.diagnosis.name.fits import ModelFit
 from harvester.diagnosis.detect.scores import Detection
 from harvester.diagnosis.detect.floor import Floor
 from harvester.diagnosis.size.missing_force import MissingForce
-from harvester.diagnosis.size.relevance import OwnForce
+from harvester.diagnosis.size.relevance import MIN_SHARE_EXPLAINED, OwnForce
 from harvester.diagnosis.name.rounds import Round, rough_rivals
 from harvester.diagnosis.name.separate import Separation, separations
 from harvester.diagnosis.size.shapes import beyond_uncertainty, has_its_shape, library_terms
@@ -62,7 +62,8 @@ def latent_unread(missing: MissingForce | None, fit: FitJudgement, limit: float)
 
 def decide_verdict(p_value: float, accepted: bool, unexplained_alpha: float, *,
                    explained: float | None = None, min_explained: float = 0.5,
-                   above_floor: bool | None = None, within_floor: bool | None = None) -> str:
+                   above_floor: bool | None = None, within_floor: bool | None = None,
+                   shown: bool | None = None) -> str:
     """"inadequate" when the baseline explains less than ``min_explained`` of the unseen
     output (``explained`` = 1 - NRMSE^2) and its residual is not shown to lie at the noise
     floor (``within_floor``); else "missing_physics" when an added effect is confirmed by
@@ -78,12 +79,36 @@ def decide_verdict(p_value: float, accepted: bool, unexplained_alpha: float, *,
     (``inference.tail``), so ``unexplained_alpha`` is reachable at any number of replicates. The
     floor and the share explained do not rest on the replicates, which take the residual's own
     level: a residual that is the whole signal cannot hide in them.
+
+    Without an accepted effect, ``shown`` (:func:`mismatch_shown`) False, a residual at the
+    noise floor and no missing force beyond its uncertainty, keeps a detection's p-value
+    alone from making the verdict: a mismatch no figure of the diagnosis shows is not
+    missing physics (issue 63: a quadratic damper's record, residual 0.975 x the floor).
     """
     if explained is not None and explained < min_explained and not within_floor:
         return "inadequate"
-    if accepted or p_value < unexplained_alpha or above_floor:
+    if accepted or above_floor or (p_value < unexplained_alpha and shown is not False):
         return "missing_physics"
     return "adequate"
+
+
+#: The residual RMS over the noise floor above which the residual shows a mismatch by itself.
+FLOOR_SHOWS = 1.0
+
+
+def mismatch_shown(fit: "FitJudgement", missing: MissingForce | None) -> bool | None:
+    """Whether the diagnosis's own figures show a mismatch: True where the residual lies
+    above the noise floor (FLOOR_SHOWS x) or the missing force stands out of its uncertainty
+    (its description readable, or its shape fitted as a term speaks); False where the
+    residual lies within the floor and the missing force, estimated, does not; None where
+    either is unmeasured (no floor, no missing force)."""
+    if fit.above(FLOOR_SHOWS):
+        return True
+    if missing is not None and (missing.description.readable or missing.shape_speaks):
+        return True
+    if fit.within(FLOOR_SHOWS) and missing is not None:
+        return False
+    return None
 
 
 @dataclass(frozen=True)
@@ -181,6 +206,9 @@ class Conclusion:
     unsampled: list[str] = field(default_factory=list)
     #: every effect the rounds screened or sampled (the evidence's verdict on it is in)
     tried: set[str] = field(default_factory=set)
+    #: candidates the evidence would accept whose implied device contradicts the sidecar
+    #: (``plausibility``), each's sentence
+    refused: list[str] = field(default_factory=list)
 
 
 def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings,
@@ -197,18 +225,24 @@ def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings
         unexplained = True
         notes.append(f"after adding {', '.join(a.effect for a in accepted)} a mismatch remains "
                      f"(p = {last.p_value:.3g})")
+    refused = []
     for rnd in rounds:
         for r in rnd.confirmed:
             if r.at_prior_edge:
                 notes.append(f"{r.effect}: the posterior of {', '.join(r.at_prior_edge)} piles "
                              "against its prior's bound; the candidate is not trusted")
+            if r.refused_for_device:  # the headline says the furthest out, the notes all
+                refused.append(max(r.contradicted, key=lambda d: d.z).sentence())
+                notes.append(f"{'; '.join(d.sentence() for d in r.contradicted)} ({r.effect} "
+                             f"gained {r.delta_log_evidence:+.1f} nats, enough to be "
+                             "accepted): not named, the next candidates were tried")
     verdict = decide_verdict(first.p_value, bool(accepted), settings.unexplained_alpha)
     named = [a.fit for a in accepted if a.named]
     return Conclusion(verdict, missing, ties, bool(unexplained), notes,
                       accepted[-1].fit if accepted else None, bool(accepted),
                       named_fit=named[-1] if named else None,
                       unsampled=[c.effect for rnd in rounds for c in rough_rivals(rnd)],
-                      tried=tried_effects(rounds))
+                      tried=tried_effects(rounds), refused=refused)
 
 
 def tried_effects(rounds: list[Round]) -> set[str]:
@@ -276,6 +310,27 @@ def nominated_terms(found: Conclusion, missing: MissingForce | None,
             if t in candidates and t not in found.tried]
 
 
+def explains_little(sizes: Sequence, library_share: float | None) -> list[str]:
+    """Mark each named effect of relevant size (``EffectSize``) that explains too little of
+    what is missing (``EffectSize.little``): its own force less than MIN_SHARE_EXPLAINED of
+    the missing force (``EffectSize.explains``) and the improved model less than it of the
+    baseline's unexplained unseen output (``library_share``, where measured). Returns a note
+    for each: such a name is not relevant missing physics."""
+    notes = []
+    for s in sizes:
+        unseen = library_share is not None and library_share >= MIN_SHARE_EXPLAINED
+        s.little = not s.negligible and s.explains < MIN_SHARE_EXPLAINED and not unseen
+        if s.little:
+            on_unseen = ("" if library_share is None else f" and the improved model "
+                         f"{100 * max(library_share, 0.0):.1f} % of the unexplained unseen "
+                         "output")
+            notes.append(f"{s.term}: its force explains {100 * max(s.explains, 0.0):.1f} % of "
+                         f"the missing force{on_unseen}; a name needs "
+                         f"{100 * MIN_SHARE_EXPLAINED:.1f} % of either to be relevant "
+                         "missing physics: not relevant")
+    return notes
+
+
 def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
           settings: DiagnosisSettings, missing: MissingForce | None = None) -> Conclusion:
     """The verdict with the fit on unseen data, the noise floor and the named effects'
@@ -286,13 +341,22 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
     limit = settings.floor_ratio
     above, within = fit.above(limit), fit.within(limit)
     sizes = missing.sizes if missing is not None else []
-    relevant = not sizes or any(not s.negligible for s in sizes)
+    little = explains_little(sizes, fit.library_share())
+    relevant = not sizes or any(not s.negligible and not s.little for s in sizes)
     verdict = decide_verdict(first.p_value, found.accepted and relevant,
                              settings.unexplained_alpha, explained=fit.explained,
                              min_explained=settings.min_explained_share,
-                             above_floor=above, within_floor=within)
+                             above_floor=above, within_floor=within,
+                             shown=mismatch_shown(fit, missing))
     notes, unexplained = list(found.notes), found.unexplained
     notes += [f"detectable but negligible: {s.sentence()}" for s in sizes if s.negligible]
+    notes += little
+    if (first.p_value < settings.unexplained_alpha and not (found.accepted and relevant)
+            and mismatch_shown(fit, missing) is False):
+        notes.append(f"the detection's p = {first.p_value:.3g} is below "
+                     f"{settings.unexplained_alpha:g}, but the residual lies within the noise "
+                     f"floor ({fit.ratio:.3g} x) and the missing force within its uncertainty: "
+                     "no mismatch the diagnosis can show, not missing physics")
     why = withheld_names(found, missing)
     if why is not None:
         notes.append(why)
@@ -421,6 +485,7 @@ def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
     if found.withheld:
         parts.append(f"no library name: {', '.join(found.withheld)} lack the missing force's "
                      "shape")
+    parts += [f"not named: {r}" for r in found.refused]
     if found.unsampled:
         one = len(found.unsampled) == 1
         parts.append(f"{', '.join(found.unsampled)} "
@@ -434,7 +499,7 @@ def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
         if not found.accepted and not shaped and latent_unread(missing, fit, limit):
             parts.append("the missing force: not readable by the smoother (its noise took the "
                          "whole residual)")
-        elif (not found.accepted or found.withheld) and missing is not None:
+        elif (not found.accepted or found.withheld or found.refused) and missing is not None:
             parts.append(f"the missing force: {missing.sentence()}")
     return "; ".join(parts)
 

@@ -87,11 +87,9 @@ def diagnosis_input(recording: str | Path, baseline: str, *,
         notes += [str(w) for w in vd.checked.warnings]
     df, val, lowpass = _filtered(checked, val, settings, lowpass_output_hz, source,
                                  validation)
-    if dev.on_ground:
-        notes.append(f"{source}: friction on the ground (sidecar friction_on): driven by the "
-                     "force k y with the output x = rel_disp + base_disp "
-                     "(harvester.data.kinds.on_ground)")
-    settings = replace(settings, lowpass_hz=lowpass, units=checked.sidecar.units or SI)
+    notes += dev.rewritten  # friction on the ground (sidecar friction_on): how it is read
+    settings = replace(settings.with_sidecar(checked.sidecar), lowpass_hz=lowpass,
+                       units=checked.sidecar.units or SI)
     check_recording(df, source, settings.lead_in_s,
                     0.0 if val is not None else settings.holdout_fraction)
     df, val, known, form_notes = friction_form(df, val, dict(kp.values), checked.sidecar,
@@ -99,8 +97,6 @@ def diagnosis_input(recording: str | Path, baseline: str, *,
     priors, prior_notes = _priors(df, baseline, known, checked.sidecar, settings, source)
     for w in warnings:
         log.warning("%s", w)
-    for line in dev.rewritten:
-        log.info("%s", line)
     return DiagnosisInput(df, val, known, priors, settings, checked.sidecar, source,
                           notes + form_notes + prior_notes, warnings)
 

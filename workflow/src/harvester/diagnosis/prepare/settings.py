@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
+from harvester.data.sidecar import DEFAULT_RELATIVE_SD, Sidecar
 from harvester.data.units import SI, Units, read_units
 from harvester.diagnosis.name.confirm import ConfirmSettings
 from harvester.diagnosis.detect.scores import DetectionSettings
@@ -50,6 +51,9 @@ class DiagnosisSettings:
     bins on the channel's noise floor, where it shows one (``data.input_noise``); False: as
     recorded. units: the recording's force and displacement units (the sidecar's ``units``,
     ``data.units``; default N and m): the labels of every size the diagnosis writes.
+    device_sd: the stated device's uncertainties, (name, sd) pairs (the sidecar's M_sd, m_sd,
+    k_sd); device_relative_sd: that of a quantity without one, relative to its value; a
+    candidate whose posterior implies a device beyond them is not named (``plausibility``).
     """
 
     particles: int = ConfirmSettings.particles
@@ -81,6 +85,8 @@ class DiagnosisSettings:
     reference_start: bool = ConfirmSettings.reference
     denoise_input: bool = True
     units: Units = SI
+    device_sd: tuple[tuple[str, float], ...] = ()
+    device_relative_sd: float = DEFAULT_RELATIVE_SD
 
     @classmethod
     def fast(cls, **overrides) -> "DiagnosisSettings":
@@ -122,7 +128,15 @@ class DiagnosisSettings:
                   for k, v in cfg.items() if k != "fast"}
         if "units" in values:  # a mapping, as a sidecar's
             values["units"] = read_units("diagnosis settings", values["units"])
+        if "device_sd" in values:  # a mapping {M: sd, ...}
+            values["device_sd"] = tuple((str(k), float(v))
+                                        for k, v in dict(values["device_sd"]).items())
         return cls.fast(**values) if cfg.get("fast") else cls(**values)
+
+    def with_sidecar(self, sidecar: Sidecar) -> "DiagnosisSettings":
+        """These settings with what a recording's sidecar states of them: its units and the
+        uncertainties of its M, m, k (``M_sd``...; ``plausibility``)."""
+        return replace(self, units=sidecar.units, device_sd=tuple(sidecar.known_sd.items()))
 
     def detection(self) -> DetectionSettings:
         return DetectionSettings(bootstrap=self.bootstrap, alpha=self.alpha,
@@ -132,4 +146,5 @@ class DiagnosisSettings:
     def confirmation(self) -> ConfirmSettings:
         return ConfirmSettings(particles=self.particles, chains=self.chains, seed=self.seed,
                                enlargements=self.enlargements, alpha=self.evidence_alpha,
-                               reference=self.reference_start)
+                               reference=self.reference_start, device_sd=self.device_sd,
+                               device_relative_sd=self.device_relative_sd)

@@ -203,6 +203,28 @@ def _candidate_entries(d) -> list[dict]:
     return out
 
 
+def _device_plausibility(d) -> dict:
+    """Each named, tied or refused term's implied device against the sidecar
+    (``plausibility``): its role, the quantities it implies and whether they agree (None
+    where it implies none the sidecar states)."""
+    from harvester.diagnosis.name.plausibility import AGREEMENT_SDS
+    tied = {e for t in d.ties for e in t.effects}
+    terms = []
+    for i, rnd in enumerate(d.rounds):
+        for r in rnd.confirmed:
+            role = ("named" if r.effect in d.missing and r.accepted else
+                    "tied" if r.effect in tied and (r.accepted or r.indistinguishable_from)
+                    else "withheld" if r.effect in d.withheld and r.accepted else
+                    "refused" if r.refused_for_device else None)
+            if role is None:
+                continue
+            terms.append({"term": r.effect, "round": i + 1, "role": role,
+                          "device": [x.to_dict() for x in r.device],
+                          "agrees": None if not r.device else not r.contradicted})
+    return {"bar_sd": AGREEMENT_SDS, "default_relative_sd": d.settings.device_relative_sd,
+            "stated_sd": dict(d.settings.device_sd), "terms": terms}
+
+
 def _output_words(d) -> str:
     """The output the likelihood compares, in words: its kind, symbol and unit, and the input
     kind the models are driven by (``harvester.data.kinds``)."""
@@ -269,6 +291,7 @@ def _diagnosis_dict(d) -> dict:
         "withheld": d.withheld,
         "indistinguishable": d.indistinguishable,
         "ties": [tie.to_dict() for tie in d.ties],
+        "device_plausibility": _device_plausibility(d),
         "unexplained_mismatch": d.unexplained,
         "baseline": d.baseline.name,
         "improved": d.improved.name,

@@ -38,7 +38,7 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import pkgutil
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import ModuleType
@@ -58,6 +58,9 @@ Z_PER_V = 1.0 / (2.0 * np.pi * 0.5)
 Z_BOUND = Z_PER_V * V_BOUND
 
 KINDS = ("screw", "mass", "inertia", "mode", "coupling")
+
+#: The device quantities a sidecar may state that a term may imply (``Term.device``).
+DEVICE_QUANTITIES = ("M", "m", "k")
 
 #: The heading of a term module's docstring section that gives each prior's reasoning.
 PRIORS_HEADING = "Priors:"
@@ -149,7 +152,11 @@ class Term:
     there is not trusted, and the diagnosis samples the other term in its place.
     ``nameable``: False for a shape of the missing force's dictionary fitted as a term
     (``diagnosis.size.shape_terms``): it describes what the library lacks and is never a
-    candidate the diagnosis names.
+    candidate the diagnosis names. ``device``: the device quantities a sidecar states (M, m,
+    k, :data:`DEVICE_QUANTITIES`) that the term's parameters change, as a function of every
+    parameter's value (a mapping; arrays over posterior draws) returning {quantity: value}:
+    an inertia error's M + dM and m + m_share dM. The diagnosis holds them against the
+    sidecar (``diagnosis.name.plausibility``); None: the term implies none of them.
     """
 
     name: str
@@ -168,6 +175,7 @@ class Term:
     alike: tuple[str, ...] = ()
     limits: tuple[tuple[str, str, str], ...] = ()
     nameable: bool = True
+    device: Callable[[Mapping], dict] | None = None
     source: str = field(default="", compare=False)  # the file that defines the term
 
     def limit(self, parameter: str, side: str) -> str | None:
@@ -222,6 +230,8 @@ def check_term(t: Term) -> None:
         problems.append("displacement_update is for a screw term with one state")
     if t.kind in ("inertia", "mode") and not callable(t.masses):
         problems.append(f"an {t.kind} term needs masses")
+    if t.device is not None and not callable(t.device):
+        problems.append("device must be a function of the parameters' values")
     if t.kind in ("mode", "coupling") and t.n_states != 2:
         problems.append(f"a {t.kind} term has 2 states, not {t.n_states}")
     for p in t.parameters:

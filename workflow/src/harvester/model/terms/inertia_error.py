@@ -22,6 +22,13 @@ def masses(M, m, dM, m_share):
     return M + dM, m + m_share * dM
 
 
+def device(values):
+    """The masses the term implies ({M, m}, kg) from every parameter's value (``values``:
+    arrays over posterior draws), for the check against the sidecar's."""
+    M, m = masses(values["M"], values["m"], values["dM"], values["m_share"])
+    return {"M": M, "m": m}
+
+
 def force(z, dM, m_share):
     """No force: the term changes the masses (``masses``)."""
     return 0.0 * z
@@ -44,7 +51,7 @@ TERM = Term(
     ),
     equation="M -> M + dM, m -> m + m_share dM (eq. 2: M = m + J (2 pi / l)^2)",
     description="effective mass differs from the assumed value",
-    force=force, masses=masses, rate_bound=rate_bound,
+    force=force, masses=masses, rate_bound=rate_bound, device=device,
     probe=Probe("dM", lambda d: 0.008 * d.M, signed=True,
                 shapes=lambda d: [{"m_share": share} for share in (0.0, 1.0)]),
     source=__file__)
