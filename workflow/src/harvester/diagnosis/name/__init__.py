@@ -6,6 +6,8 @@
 ``screen``       the candidates' best fits (MAP), which bound the evidence each can gain
 ``smoothness``   whether a candidate's likelihood is smooth enough to sample
 ``confirm``      TMCMC of the augmented structures, their evidence, ties
+``plausibility`` a candidate's implied device (masses, stiffness) against the sidecar's
+                 measurements: a name whose device contradicts them is not given
 ``rounds``       detect -> rank -> screen -> confirm, one effect added per round
 ``separate``     the measurement that would tell two tied effects apart
 ``verdict``      what is concluded: the verdict, the names, the ties, what is withheld
