@@ -1,0 +1,70 @@
+"""Stribeck excess of a dry friction that sticks: breakaway above the sliding level,
+
+    f = [F_dry + F_break exp(-(|w| / v_break)^delta_break)] sgn(w)   sliding,
+    |f| <= F_dry + F_break                                              stuck (w = 0),
+
+so the contact holds up to the static level F_s = F_dry + F_break and, once broken away,
+its friction falls towards the sliding level F_dry as it speeds up (Armstrong-Helouvry,
+Dupont and Canudas de Wit 1994). A refinement of ``sticking_friction`` (meaningless without
+it); the smooth counterpart is ``stribeck_friction``. v_break -> 0 is Karnopp's (1985) jump
+from the static to the sliding level.
+
+Priors:
+
+- F_break: the static level exceeds the sliding one by a hundredth of the damping force the
+  motion shows to twice it, as ``stribeck_friction``'s excess (static/sliding ratios of
+  1.1-2 in the tribology literature sit inside it for any sliding level of the
+  ``F_dry`` prior)
+- v_break: the Stribeck velocity from 1/100 of the RMS velocity to 3 x it: Stribeck
+  velocities span 1e-5 to 1e-1 m/s (Armstrong-Helouvry et al. 1994); below 1/100 of the RMS
+  velocity the decay is over within a recording's velocity resolution (a jump, Karnopp's), and
+  its slope F_break / v_break sets the integrator's step; above 3 x it, it is viscous-like
+- delta_break: the decay's exponent: 1 (exponential) and 2 (Gaussian) are the literature's
+  forms; below 1 the decay's slope is infinite at breakaway
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from harvester.model import fastmath as fm
+from harvester.model.priors import Prior
+from harvester.model.terms import STICKING_FRICTION, Motion, Parameter, Probe, RateBound, Term
+
+
+def force(speed, F_break, v_break, delta_break):
+    """The excess F_break exp(-(speed / v_break)^delta_break) (N) at a speed >= 0 (m/s)."""
+    r = speed / v_break
+    return F_break * fm.exp(-fm.exp(delta_break * fm.log(r + 1e-300)))
+
+
+def static(F_break, v_break, delta_break):
+    """The excess's share of the holding level: F_break (N)."""
+    return F_break
+
+
+def rate_bound(p: dict, motion: Motion) -> RateBound:
+    """|d f / d w| <= delta F_break / v_break (the decay's steepest slope, attained for
+    delta = 1 at breakaway)."""
+    vb = np.maximum(np.abs(p["v_break"]), 1e-9)
+    return RateBound(damping=np.abs(p["delta_break"]) * np.abs(p["F_break"]) / vb)
+
+
+TERM = Term(
+    name="sticking_stribeck", kind="stick",
+    parameters=(
+        Parameter("F_break", "N", Prior("loguniform", 0.01, 2.0, "force"),
+                  "excess of the static (breakaway) over the sliding level"),
+        Parameter("v_break", "m/s", Prior("loguniform", 1.0 / 100.0, 3.0, "v"),
+                  "Stribeck velocity of the sticking law"),
+        Parameter("delta_break", "-", Prior("normal", 1.5, 0.5, lower=1.0, upper=3.0),
+                  "exponent of the decay from breakaway"),
+    ),
+    equation="f = [F_dry + F_break exp(-(|w| / v_break)^delta_break)] sgn(w) sliding; "
+             "w = 0 while |force needed| <= F_dry + F_break",
+    description="Stribeck excess of a dry friction that sticks (breakaway above sliding)",
+    force=force, static=static, rate_bound=rate_bound, refines=STICKING_FRICTION,
+    alike=("stribeck_friction",),
+    probe=Probe("F_break", lambda d: 0.1 * d.force,
+                shapes=lambda d: [{"v_break": f * d.v} for f in (0.01, 0.1, 1.0)]),
+    source=__file__)
