@@ -57,7 +57,7 @@ def breakaway(f0, f1, level):
     """Share of a step (0-1) at which a force going linearly from f0 to f1 (N) reaches the
     level +-``level`` on f1's side; 0 where it started beyond it."""
     target = level if f1 > 0.0 else -level
-    if f1 == f0:
+    if abs(f0) > level or f1 == f0:
         return 0.0
     return min(max((target - f0) / (f1 - f0), 0.0), 1.0)
 
