@@ -102,8 +102,19 @@ def crossing(v0, m0, v1, m1):
 # --------------------------------------------------------------------------- the source
 
 
+def _excluded(terms) -> list[str]:
+    """The terms a structure with stick terms cannot hold (module docstring's limits)."""
+    return [t.name for t in terms if t.kind == "coupling" or t.displacement_update is not None]
+
+
+def compatible(terms) -> bool:
+    """Whether the integrator takes a structure (its Term objects): no stick term, or none
+    of the terms it cannot hold beside one."""
+    return not has_stick(terms) or not _excluded(terms)
+
+
 def _check(terms) -> None:
-    bad = [t.name for t in terms if t.kind == "coupling" or t.displacement_update is not None]
+    bad = _excluded(terms)
     if bad:
         raise ValueError(f"a structure with dry friction that sticks cannot hold {bad}: a "
                          "coupling or a state advanced along the screw's path "
