@@ -9,6 +9,9 @@ left-hand side of eq. (1) with the stated masses M and m:
 ``inertia``  (M, m) -> (M', m') = masses(M, m; params): X = (M' - M) z'' + (m' - m) y''
 ``mode``     states (u, u') driven by the path's z'' and y'' (RK4 with the acceleration
              linear in a step); X = -force(u, u'; params) + (M' - M) z'' + (m' - m) y''
+``stick``    X = sgn(z') force(|z'|; params) while the path moves; where it is stuck (z' = 0
+             exactly, a simulated path) the holding force is what the drive leaves, which
+             the paths do not carry: 0 there (the share it explains is then a lower bound)
 ``coupling`` not expressible as a force on the mass (a dead zone between two inertias)
 
 Each term's law is the library's own (``harvester.model.codegen.compiled``): no physics is
@@ -128,6 +131,8 @@ def term_force(t: Term, values: Mapping[str, float], z: np.ndarray, v: np.ndarra
     if t.kind == "screw" and t.n_states == 1:
         return _with_rates(compiled(t.name, "force"), compiled(t.name, "state_rates"), v, dt,
                            16, params)
+    if t.kind == "stick":  # sliding: sgn(z') times its magnitude; stuck (z' = 0): 0 here
+        return np.sign(v) * _stateless(compiled(t.name, "force"), np.abs(v), params)
     if t.kind == "inertia":
         return _inertial(t, values, params, a, yb)
     if t.kind == "mode":
