@@ -185,3 +185,29 @@ def test_marino_cicirello_friction_oscillator(tmp_path: Path):
                    1 / 500.0, force_input=True)
     assert stuck_share(sim.rel_vel[0]) == stuck_share(ref.v) > 0.05
     assert np.max(np.abs(sim.rel_disp[0] - ref.x)) < 1e-4 * np.max(np.abs(ref.x))
+
+
+@pytest.mark.slow
+def test_karnopp_element_converges_to_the_sticking_law():
+    """The literature generator's Karnopp element (its own integrator; share 1, breakaway
+    1.5 x sliding) with its stick band narrowed to 1e-4 of the RMS velocity against
+    sticking_friction + sticking_stribeck with the same levels and a Stribeck velocity of
+    1e-3 of it (the jump), driven by the same base acceleration at the generator's rate."""
+    from harvester.synthetic import literature as lit
+    dev = lit.draw_device(np.random.default_rng(3))
+    tb = lit.TimeBase(256.0, 8 * 256)
+    tg = np.arange(2 * tb.n_int + 8) * tb.h_int / 2
+    y2 = 0.25 * dev.peak_base_acc * np.minimum(tg / 0.5, 1) ** 2 * (
+        0.7 * np.sin(2 * np.pi * 0.8 * dev.f_n * tg)
+        + 0.3 * np.sin(2 * np.pi * 1.7 * dev.f_n * tg + 0.4))
+    v_rms = np.std(lit.simulate(lit.NONE, dev.params(), y2, tb, 4)[2])
+    p = dev.params()
+    p[lit.E:lit.E + 3] = 1.0, 1.5, 1e-4 * v_rms
+    _, z, v = lit.simulate(lit.KARNOPP, p, y2, tb, 8)
+    sim = simulate(Layout.of(["sticking_friction", "sticking_stribeck"]),
+                   [dev.M, dev.m, dev.k, dev.c, dev.F_c, 0.5 * dev.F_c, 1e-3 * v_rms, 2.0],
+                   y2[:2 * tb.n_int:2], tb.h_int)
+    karnopp_stuck = np.mean(np.abs(v) < p[lit.E + 2])
+    assert karnopp_stuck > 0.15
+    assert abs(stuck_share(sim.rel_vel[0]) - karnopp_stuck) < 0.005
+    assert np.max(np.abs(sim.rel_disp[0] - z)) < 3e-3 * np.max(np.abs(z))

@@ -312,7 +312,8 @@ def source(terms: tuple[str, ...], driver: str) -> str:
     imports = []
     for i, t in enumerate(objs):
         for fn, local in (("force", "_force"), ("state_rates", "_rates"), ("masses", "_masses"),
-                          ("displacement_update", "_update"), ("static", "_static")):
+                          ("displacement_update", "_update"), ("static", "_static"),
+                          ("transition", "_transition")):
             if getattr(t, fn) is not None:
                 imports.append(f'{local}{i} = compiled("{t.name}", "{fn}")')
     jit = '@nb.njit(error_model="numpy", cache=True'
@@ -321,7 +322,8 @@ def source(terms: tuple[str, ...], driver: str) -> str:
         f' driver {driver}. Do not edit."""',
         "import numba as nb", "import numpy as np", "",
         "from harvester.model.codegen import BLOW_UP, compiled, turning_point", "",
-        *(["from harvester.model.stick import breakaway, crossing, MAX_EVENTS", ""]
+        *(["from harvester.model.stick import (MAX_EVENTS, TRANSITION_RATE_H, breakaway, "
+           "crossing)", ""]
           if has_stick(objs) else []),
         *imports, "", "",
         f'{jit}, inline="always")', _rhs_source(objs, driver), "", "",

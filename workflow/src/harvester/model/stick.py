@@ -42,6 +42,9 @@ import numba as nb
 
 #: Events located per sub-step at most.
 MAX_EVENTS = 4
+#: Largest (a stick term's slope below its transition speed / M) x piece: the sub-step is cut
+#: into pieces that short while sliding that slowly (``simulate.RATE_H``'s value).
+TRANSITION_RATE_H = 0.5
 #: Illinois iterations on the Hermite cubic for the instant z' crosses zero (h / 2^30 at worst
 #: for bisection; the Illinois method converges superlinearly).
 CROSSING_ITERATIONS = 30
@@ -142,45 +145,64 @@ def _rk4_source(states: list[str], params: list[str]) -> str:
         stage("d", "c", "h", "h"), f"    return ({out},)"])
 
 
-def _step_source(states: list[str], params: list[str], statics: str) -> str:
-    """``stick_step``: one sub-step of a particle from ua to uc (input at its ends), with
-    the events of the module docstring; returns (direction, states, rhs at the end)."""
+def _step_source(states: list[str], params: list[str], statics: str,
+                 transitions: list[str]) -> str:
+    """``stick_piece``: one RK4 step of at most h, cut at its first event (module
+    docstring); returns (time advanced, direction, states, rhs there). ``stick_step``: one
+    sub-step of a particle from ua to uc (input at its ends) in pieces: whole while stuck or
+    sliding fast, 1/fine of the sub-step while sliding below the stick terms' (summed)
+    transition speeds, where their laws change at the summed slope (``Term.transition``)."""
     n = len(states)
     ys = ", ".join(f"y{j}" for j in range(n))
     ns = ", ".join(f"n{j}" for j in range(n))
     ks = ", ".join(f"k{j}" for j in range(n + 2))
     ps = ", ".join(params)
-    return f"""def stick_step(ua, uc, h, _s, {ys}, {ks}, {ps}):
-    du = (uc - ua) / h
+    names = [f"_tr{j}" for j in range(len(transitions))]
+    speed = " + ".join(f"{t}[0]" for t in names) or "0.0"
+    slope = " + ".join(f"{t}[1]" for t in names) or "0.0"
+    calls = "\n".join(f"    {t} = {call}" for t, call in zip(names, transitions))
+    return f"""def stick_piece(u0, du, h, test, _s, {ys}, {ks}, {ps}):
     level = {statics}
+    {ns}, = rk4(u0, du, h, _s, {ys}, {ks}, {ps})
+    e = rhs(u0 + du * h, _s, {ns}, {ps})
+    theta = 1.0
+    if test:
+        if _s == 0.0:
+            if abs(e[1]) > level:
+                theta = breakaway(k1, e[1], level)
+        elif _s * n1 <= 0.0:
+            theta = crossing(y1, k0 * h, n1, e[0] * h)
+    if theta >= 1.0:
+        return (h, _s, {ns}) + e
+    tau = theta * h
+    if tau > 0.0:
+        {ys}, = rk4(u0, du, tau, _s, {ys}, {ks}, {ps})
+    y1 = 0.0
+    g = rhs(u0 + du * tau, 0.0, {ys}, {ps})
+    if _s != 0.0 and abs(g[1]) <= level:
+        return (tau, 0.0, {ys}) + g
+    _s = 1.0 if g[1] > 0.0 else -1.0
+    return (tau, _s, {ys}) + rhs(u0 + du * tau, _s, {ys}, {ps})
+
+
+{{jit}})
+def stick_step(ua, uc, h, _s, {ys}, {ks}, {ps}):
+    du = (uc - ua) / h
+{calls}
+    slow = {speed}
+    fine = max(1.0, np.ceil(({slope}) / abs(M) * h / TRANSITION_RATE_H))
+    pieces = int(fine) + 2 * MAX_EVENTS
     t = 0.0
-    rem = h
-    for ev in range(MAX_EVENTS):
-        u0 = ua + du * t
-        {ns}, = rk4(u0, du, rem, _s, {ys}, {ks}, {ps})
-        e = rhs(u0 + du * rem, _s, {ns}, {ps})
-        theta = 1.0
-        if ev < MAX_EVENTS - 1:
-            if _s == 0.0:
-                if abs(e[1]) > level:
-                    theta = breakaway(k1, e[1], level)
-            elif _s * n1 <= 0.0:
-                theta = crossing(y1, k0 * rem, n1, e[0] * rem)
-        if theta >= 1.0:
-            return (_s, {ns}) + e
-        tau = theta * rem
-        if tau > 0.0:
-            {ys}, = rk4(u0, du, tau, _s, {ys}, {ks}, {ps})
-        y1 = 0.0
-        t += tau
+    for it in range(pieces):
         rem = h - t
-        g = rhs(ua + du * t, 0.0, {ys}, {ps})
-        if _s != 0.0 and abs(g[1]) <= level:
-            _s = 0.0
-            {ks} = g
-        else:
-            _s = 1.0 if g[1] > 0.0 else -1.0
-            {ks} = rhs(ua + du * t, _s, {ys}, {ps})
+        if rem <= 1e-12 * h:
+            break
+        test = it < pieces - 1
+        hp = rem
+        if test and _s != 0.0 and _s * y1 < slow:
+            hp = min(rem, h / fine)
+        adv, _s, {ys}, {ks} = stick_piece(ua + du * t, du, hp, test, _s, {ys}, {ks}, {ps})
+        t += adv
     return (_s, {ys}, {ks})"""
 
 
@@ -250,6 +272,9 @@ def stick_source(terms, driver: str, jit: str) -> list[str]:
     params, states = _names(terms)
     statics = " + ".join(f"_static{i}({', '.join(t.parameter_names)})"
                          for i, t in enumerate(terms) if t.kind == "stick")
+    transitions = [f"_transition{i}({', '.join(t.parameter_names)})"
+                   for i, t in enumerate(terms) if t.transition is not None]
+    step = _step_source(states, params, statics, transitions).replace("{jit}", jit)
     return [f'{jit}, inline="always")', _rk4_source(states, params), "", "",
-            f"{jit})", _step_source(states, params, statics), "", "",
+            f'{jit}, inline="always")', step, "", "",
             f"{jit}, nogil=True)", _integrate_source(states, params, driver)]

@@ -158,7 +158,11 @@ class Term:
     (``diagnosis.shape_terms``): it describes what the library lacks and is never a
     candidate the diagnosis names.
     ``static`` (a ``stick`` term): its share of the holding level (N), a function of its
-    parameters.
+    parameters. ``transition`` (a ``stick`` term whose law changes fast at low speed, a
+    Stribeck decay): (speed, slope) = transition(*params), the speed (m/s) below which the
+    law changes and its steepest slope there (N s/m); the integrator cuts its sub-steps to
+    that slope only while sliding slower (``harvester.model.stick``), so ``rate_bound`` leaves
+    it out.
     """
 
     name: str
@@ -174,6 +178,7 @@ class Term:
     masses: Callable | None = None
     displacement_update: Callable | None = None
     static: Callable | None = None
+    transition: Callable | None = None
     refines: tuple[str, ...] = ()
     alike: tuple[str, ...] = ()
     limits: tuple[tuple[str, str, str], ...] = ()
@@ -236,6 +241,8 @@ def check_term(t: Term) -> None:
         problems.append("displacement_update is for a screw term with one state")
     if (t.kind == "stick") != callable(t.static):
         problems.append("a stick term, and only one, gives static (its holding level)")
+    if t.transition is not None and t.kind != "stick":
+        problems.append("transition is for a stick term")
     if t.kind == "stick" and t.n_states:
         problems.append("a stick term has no states of its own")
     if t.kind in ("inertia", "mode") and not callable(t.masses):

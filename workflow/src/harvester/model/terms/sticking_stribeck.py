@@ -25,11 +25,13 @@ Priors:
 
 from __future__ import annotations
 
-import numpy as np
-
 from harvester.model import fastmath as fm
 from harvester.model.priors import Prior
 from harvester.model.terms import STICKING_FRICTION, Motion, Parameter, Probe, RateBound, Term
+
+#: The decay's transition speed in Stribeck velocities: at 5 v_break the excess is exp(-5) of
+#: F_break for delta = 1 (less for delta > 1).
+TRANSITION_SPEEDS = 5.0
 
 
 def force(speed, F_break, v_break, delta_break):
@@ -43,11 +45,16 @@ def static(F_break, v_break, delta_break):
     return F_break
 
 
+def transition(F_break, v_break, delta_break):
+    """(speed, slope): below TRANSITION_SPEEDS x v_break (m/s) the decay changes at up to
+    delta F_break / v_break (N s/m; attained for delta = 1 at breakaway), the integrator's
+    pieces cut to it there; above, the slope is below exp(-5) of that."""
+    return TRANSITION_SPEEDS * v_break, delta_break * F_break / v_break
+
+
 def rate_bound(p: dict, motion: Motion) -> RateBound:
-    """|d f / d w| <= delta F_break / v_break (the decay's steepest slope, attained for
-    delta = 1 at breakaway)."""
-    vb = np.maximum(np.abs(p["v_break"]), 1e-9)
-    return RateBound(damping=np.abs(p["delta_break"]) * np.abs(p["F_break"]) / vb)
+    """Nothing beyond the transition (``transition``: the integrator refines below it)."""
+    return RateBound()
 
 
 TERM = Term(
@@ -63,7 +70,8 @@ TERM = Term(
     equation="f = [F_dry + F_break exp(-(|w| / v_break)^delta_break)] sgn(w) sliding; "
              "w = 0 while |force needed| <= F_dry + F_break",
     description="Stribeck excess of a dry friction that sticks (breakaway above sliding)",
-    force=force, static=static, rate_bound=rate_bound, refines=STICKING_FRICTION,
+    force=force, static=static, transition=transition, rate_bound=rate_bound,
+    refines=STICKING_FRICTION,
     alike=("stribeck_friction",),
     probe=Probe("F_break", lambda d: 0.1 * d.force,
                 shapes=lambda d: [{"v_break": f * d.v} for f in (0.01, 0.1, 1.0)]),
