@@ -32,12 +32,20 @@ from harvester.model.terms import STICKING_FRICTION, Motion, Parameter, Probe, R
 #: The decay's transition speed in Stribeck velocities: at 5 v_break the excess is exp(-5) of
 #: F_break for delta = 1 (less for delta > 1).
 TRANSITION_SPEEDS = 5.0
+#: Beyond this many Stribeck velocities the excess is exp(-37) < 1e-16 of F_break (delta >= 1).
+FLAT_RATIO = 37.0
 
 
 def force(speed, F_break, v_break, delta_break):
-    """The excess F_break exp(-(speed / v_break)^delta_break) (N) at a speed >= 0 (m/s)."""
+    """The excess F_break exp(-(speed / v_break)^delta_break) (N) at a speed >= 0 (m/s);
+    without its three elementary functions where they change nothing: at rest (F_break) and
+    beyond FLAT_RATIO Stribeck velocities (0: below 1e-16 of F_break for delta >= 1)."""
     r = speed / v_break
-    return F_break * fm.exp(-fm.exp(delta_break * fm.log(r + 1e-300)))
+    if r == 0.0:
+        return F_break
+    if r > FLAT_RATIO:
+        return 0.0
+    return F_break * fm.exp(-fm.exp(delta_break * fm.log(r)))
 
 
 def static(F_break, v_break, delta_break):
