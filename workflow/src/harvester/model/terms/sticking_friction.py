@@ -19,8 +19,6 @@ Priors:
 
 from __future__ import annotations
 
-import numpy as np
-
 from harvester.model.priors import Prior
 from harvester.model.terms import Motion, Parameter, Probe, RateBound, Term
 
