@@ -12,13 +12,13 @@ from the static to the sliding level.
 Priors:
 
 - F_break: the static level exceeds the sliding one by a hundredth of the damping force the
-  motion shows to twice it, as ``stribeck_friction``'s excess (static/sliding ratios of
-  1.1-2 in the tribology literature sit inside it for any sliding level of the
-  ``F_dry`` prior)
+  motion shows to twice it, as ``stribeck_friction``'s excess: static/sliding ratios of 1.2-2
+  (the literature generator's Karnopp element) sit inside it for sliding levels from a tenth
+  of that force up
 - v_break: the Stribeck velocity from 1/100 of the RMS velocity to 3 x it: Stribeck
   velocities span 1e-5 to 1e-1 m/s (Armstrong-Helouvry et al. 1994); below 1/100 of the RMS
   velocity the decay is over within a recording's velocity resolution (a jump, Karnopp's), and
-  its slope F_break / v_break sets the integrator's step; above 3 x it, it is viscous-like
+  the integrator's pieces below 5 v_break shorten with it; above 3 x it, it is viscous-like
 - delta_break: the decay's exponent: 1 (exponential) and 2 (Gaussian) are the literature's
   forms; below 1 the decay's slope is infinite at breakaway
 """
