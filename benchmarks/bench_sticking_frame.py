@@ -9,6 +9,11 @@ authors' values). Each structure's c_m and friction parameters are fitted by
 record), the output's mean free; the misfit is the RMS residual (m). A point estimate from
 one start, not a posterior: a local optimum is possible.
 
+Then the log-likelihood of the 450 g record about the Stribeck form's MAP that ``harvester
+diagnose`` found for it (``MAP_450``, sigma ``SIGMA_450``), along F_dry, F_break and v_break
+on grids of 41, 81 and 161 points: the largest step between neighbours halves with the
+spacing where the likelihood is continuous.
+
 Run: ``.venv/bin/python benchmarks/bench_sticking_frame.py`` (about a minute).
 """
 
@@ -24,7 +29,7 @@ from scipy.optimize import least_squares
 
 from harvester.data.kinds import on_ground
 from harvester.data.public import FRAME_DEVICE
-from harvester.model.simulate import simulate
+from harvester.model.simulate import residual_sums, simulate
 from harvester.model.structures import Layout
 
 FRAME = Path(__file__).resolve().parents[1] / "data" / "public" / "marino-frame"
@@ -69,12 +74,40 @@ def fit(terms, start, lower, upper, u, x, dt) -> None:
           f"um, stuck {np.mean(v == 0):.3f}; {values} ({time.perf_counter() - t0:.0f} s)")
 
 
+#: linear+sticking_friction+sticking_stribeck's MAP on the 450 g record (the diagnosis's log:
+#: c_m, F_dry, F_break, v_break, delta_break) and its sigma (m).
+MAP_450 = {"c_m": 77.93, "F_dry": 0.09255, "F_break": 0.9731, "v_break": 0.008853,
+           "delta_break": 2.703}
+SIGMA_450 = 1.019e-4
+#: Half-widths of the grids about the MAP.
+HALF = {"F_dry": 0.022, "F_break": 0.022, "v_break": 0.001}
+
+
+def continuity(u, x, dt) -> None:
+    lay = Layout.of(["sticking_friction", "sticking_stribeck"])
+    w = (int(WINDOW_S[0] / dt), int(WINDOW_S[1] / dt))
+    row = np.r_[FRAME_DEVICE["M"], FRAME_DEVICE["M"], FRAME_DEVICE["k"], list(MAP_450.values())]
+    for name, half in HALF.items():
+        steps = []
+        for num in (41, 81, 161):
+            P = np.tile(row, (num, 1))
+            j = lay.index(name)
+            P[:, j] = np.linspace(row[j] - half, row[j] + half, num)
+            sse, _ = residual_sums(lay, P, u, dt, x[w[0]:w[1]], w, output_kind="rel_disp",
+                                   force_input=True)
+            steps.append(np.max(np.abs(np.diff(sse))) / (2 * SIGMA_450**2))
+        print(f"  {name} +- {half:g}: largest step " + ", ".join(f"{s:.3g}" for s in steps)
+              + " nats (41, 81, 161 points)")
+
+
 def main() -> None:
     for load in (250, 450):
         u, x, dt = recording(load)
         print(f"frame {load} g on the ground, unfiltered, {WINDOW_S[0]}-{WINDOW_S[1]} s:")
         for terms, start, lower, upper in FITS:
             fit(terms, start, lower, upper, u, x, dt)
+    print("log-likelihood about the Stribeck form's MAP at 450 g:")
+    continuity(u, x, dt)
 
 
 if __name__ == "__main__":
