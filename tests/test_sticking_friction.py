@@ -211,3 +211,22 @@ def test_karnopp_element_converges_to_the_sticking_law():
     assert karnopp_stuck > 0.15
     assert abs(stuck_share(sim.rel_vel[0]) - karnopp_stuck) < 0.005
     assert np.max(np.abs(sim.rel_disp[0] - z)) < 3e-3 * np.max(np.abs(z))
+
+
+def test_named_force_holds_where_stuck():
+    """Along a simulated path the named sticking law's force closes eq. (1) at every sample:
+    its sliding law while moving, the holding force where stuck."""
+    from harvester.diagnosis.term_forces import named_force, term_force
+    f = forcing(3.0)
+    lay = Layout.of(["sticking_friction"])
+    sim = simulate(lay, [M, 1.0, K, C, 2.0], f, 1 / FS, force_input=True)
+    values = {"M": M, "m": 1.0, "k": K, "c_m": C, "F_dry": 2.0}
+    z, v, a = sim.rel_disp, sim.rel_vel, sim.rel_acc
+    x = named_force(lay, values, z, v, a, np.zeros_like(f), f, 1 / FS, ("sticking_friction",))
+    stuck = v[0] == 0.0
+    assert 0.3 < stuck.mean() < 0.7
+    closure = M * a + C * v + K * z + x - f
+    assert np.max(np.abs(closure)) < 1e-6 * np.max(np.abs(f))
+    sliding = term_force(TERMS["sticking_friction"], values, z, v, a, np.zeros_like(f), 1 / FS)
+    np.testing.assert_array_equal(x[0, ~stuck], sliding[0, ~stuck])
+    assert np.all(np.abs(x[0, stuck]) <= 2.0 * (1 + 1e-9))
