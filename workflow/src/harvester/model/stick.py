@@ -25,8 +25,12 @@ test at its end:
   or slides on in the direction of f_need (a reversal without a stop).
 
 So the trajectory, and a likelihood built on it, changes continuously with the parameters:
-an event moves with them instead of snapping to the step's grid. At most ``MAX_EVENTS``
-events per sub-step (the last part is integrated without a test). The right-hand side's
+an event moves with them instead of snapping to the step's grid. A sub-step is cut at its
+events into pieces, at most its refinement (below) plus 2 ``MAX_EVENTS`` of them, the last
+integrated without a test. A velocity that dips through zero and back within one step (its
+sign the same at both ends) is not seen: the step's length bounds such a dip. While sliding
+slower than a stick term's transition speed (a Stribeck decay's few Stribeck velocities,
+``Term.transition``) the pieces are cut to the law's slope there. The right-hand side's
 value at the end of each step is the next step's first stage (first same as last), so a
 sub-step costs four evaluations as RK4 does. Particles are integrated one at a time (the
 events branch); ``benchmarks/bench_sticking.py`` prints the cost against the smooth law.
