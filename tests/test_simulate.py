@@ -129,6 +129,8 @@ TERM_PARAMS = {
     "inertia_error": [0.8, 0.5],
     "offset_force": [3.0],
     "periodic_force": [3.0, 1.0, 0.005],
+    "sticking_friction": [8.0],
+    "sticking_stribeck": [3.0, 0.02, 2.0],
 }
 
 

@@ -53,6 +53,8 @@ from types import ModuleType
 
 import numba as nb
 
+from harvester.model.stick import has_stick
+from harvester.model.stick import stick_source as _stick_source
 from harvester.model.terms import Term, term
 
 #: States beyond this magnitude count as a failed (unstable) simulation.
@@ -112,7 +114,9 @@ def _names(terms: tuple[Term, ...]) -> tuple[list[str], list[str]]:
 def _rhs_source(terms: tuple[Term, ...], driver: str) -> str:
     """The right-hand side: (a, d state / dt ...) of one particle."""
     params, states = _names(terms)
-    lines = [f"def rhs(_u, {', '.join(states)}, {', '.join(params)}):",
+    sticks = [i for i, t in enumerate(terms) if t.kind == "stick"]
+    mode = "_s, " if sticks else ""
+    lines = [f"def rhs(_u, {mode}{', '.join(states)}, {', '.join(params)}):",
              "    _M = M", "    _m = m"]
     state_of = {}
     k = 2
@@ -147,6 +151,13 @@ def _rhs_source(terms: tuple[Term, ...], driver: str) -> str:
                   "    _a = (_drive - _f_mass - _fb + _f_mode) / _m",
                   f"    _d{dd} = _a - (_fb - _f_screw) / _j_eq"]
         derivs[d], derivs[dd] = dd, f"_d{dd}"
+    elif sticks:
+        # stuck (_s = 0): w = 0 held, the friction supplies _f_other; sliding in the direction
+        # _s = +-1: the stick terms' magnitude at the speed along it
+        dry = " + ".join(f"_force{i}(_sp, {args[i]})" for i in sticks)
+        lines += ["    _f_other = _drive - _f_screw - _f_mass + _f_mode",
+                  "    _sp = max(_s * _w, 0.0)",
+                  f"    _a = abs(_s) * (_f_other - _s * ({dry})) / _M"]
     else:
         lines.append("    _a = (_drive - _f_screw - _f_mass + _f_mode) / _M")
     for i, t in enumerate(terms):
@@ -160,7 +171,8 @@ def _rhs_source(terms: tuple[Term, ...], driver: str) -> str:
             lines.append(f"    _d{u0}, _d{u1} = _rates{i}({u0}, {u1}, _a, _yb, {args[i]})")
             derivs.update({u0: f"_d{u0}", u1: f"_d{u1}"})
     derivs["z"], derivs["v"] = "v", "_a"
-    lines.append("    return _a, " + ", ".join(derivs[s] for s in states))
+    need = "_f_other, " if sticks else ""
+    lines.append(f"    return _a, {need}" + ", ".join(derivs[s] for s in states))
     return "\n".join(lines)
 
 
@@ -300,7 +312,8 @@ def source(terms: tuple[str, ...], driver: str) -> str:
     imports = []
     for i, t in enumerate(objs):
         for fn, local in (("force", "_force"), ("state_rates", "_rates"), ("masses", "_masses"),
-                          ("displacement_update", "_update")):
+                          ("displacement_update", "_update"), ("static", "_static"),
+                          ("transition", "_transition")):
             if getattr(t, fn) is not None:
                 imports.append(f'{local}{i} = compiled("{t.name}", "{fn}")')
     jit = '@nb.njit(error_model="numpy", cache=True'
@@ -309,9 +322,13 @@ def source(terms: tuple[str, ...], driver: str) -> str:
         f' driver {driver}. Do not edit."""',
         "import numba as nb", "import numpy as np", "",
         "from harvester.model.codegen import BLOW_UP, compiled, turning_point", "",
+        *(["from harvester.model.stick import (MAX_EVENTS, TRANSITION_RATE_H, breakaway, "
+           "crossing)", ""]
+          if has_stick(objs) else []),
         *imports, "", "",
         f'{jit}, inline="always")', _rhs_source(objs, driver), "", "",
-        f"{jit}, nogil=True)", _integrate_source(objs, driver)])
+        *(_stick_source(objs, driver, jit) if has_stick(objs) else
+          [f"{jit}, nogil=True)", _integrate_source(objs, driver)])])
 
 
 # --------------------------------------------------------------------------- the cache
@@ -326,7 +343,7 @@ def cache_dir() -> Path:
 def _dependencies(terms: tuple[str, ...]) -> list[Path]:
     here = Path(__file__).parent
     deps = [Path(__file__), here / "fastmath.py", here / "acquisition.py",
-            here / "terms" / "__init__.py"]
+            here / "terms" / "__init__.py", here / "stick.py"]
     return deps + [Path(term(n).source) for n in terms]
 
 

@@ -9,6 +9,10 @@ left-hand side of eq. (1) with the stated masses M and m:
 ``inertia``  (M, m) -> (M', m') = masses(M, m; params): X = (M' - M) z'' + (m' - m) y''
 ``mode``     states (u, u') driven by the path's z'' and y'' (RK4 with the acceleration
              linear in a step); X = -force(u, u'; params) + (M' - M) z'' + (m' - m) y''
+``stick``    X = sgn(z') force(|z'|; params) while the path moves; where it is stuck (z' = 0
+             exactly, a simulated path) the holding force is what the drive leaves, which
+             ``term_force`` does not get: 0 there; :func:`named_force`, given the drive,
+             puts the holding force there
 ``coupling`` not expressible as a force on the mass (a dead zone between two inertias)
 
 Each term's law is the library's own (``harvester.model.codegen.compiled``): no physics is
@@ -128,6 +132,8 @@ def term_force(t: Term, values: Mapping[str, float], z: np.ndarray, v: np.ndarra
     if t.kind == "screw" and t.n_states == 1:
         return _with_rates(compiled(t.name, "force"), compiled(t.name, "state_rates"), v, dt,
                            16, params)
+    if t.kind == "stick":  # sliding: sgn(z') times its magnitude; stuck (z' = 0): 0 here
+        return np.sign(v) * _stateless(compiled(t.name, "force"), np.abs(v), params)
     if t.kind == "inertia":
         return _inertial(t, values, params, a, yb)
     if t.kind == "mode":
@@ -155,3 +161,30 @@ def model_force(layout: Layout, values: Mapping[str, float], z: np.ndarray, v: n
     for f in term_forces(layout, values, z, v, a, yb, dt).values():
         total = total + f
     return total
+
+
+def named_force(layout: Layout, values: Mapping[str, float], z: np.ndarray, v: np.ndarray,
+                a: np.ndarray, yb: np.ndarray, drive: np.ndarray, dt: float,
+                names: tuple[str, ...]) -> np.ndarray:
+    """The summed X_T (N) of the terms ``names`` along a simulated path (draws, samples).
+    Where the path is stuck (z' = 0 exactly) and the layout holds ``stick`` terms, their force
+    is the holding force, what eq. (1) leaves with the drive (N, samples): drive - M z'' -
+    c_m z' - k z - the other terms' X_T, shared among the stick terms by their holding
+    levels (``Term.static``); elsewhere each term's own law (:func:`term_force`)."""
+    z, v, a = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (z, v, a))
+    sticks = [t for t in layout.terms if t.kind == "stick"]
+    if not any(t.name in names for t in sticks):  # the named terms' laws alone
+        return sum((term_force(t, values, z, v, a, yb, dt) for t in layout.terms
+                    if t.name in names), np.zeros_like(z))
+    forces = term_forces(layout, values, z, v, a, yb, dt)
+    out = sum((forces[n] for n in names), np.zeros_like(z))
+    others = sum((f for n, f in forces.items() if n not in {t.name for t in sticks}),
+                 np.zeros_like(z))
+    hold = (np.asarray(drive, dtype=float)[None, :] - values["M"] * a - values["c_m"] * v
+            - values["k"] * z - others)
+    levels = {t.name: abs(float(compiled(t.name, "static")(
+        *(float(values[p]) for p in t.parameter_names)))) for t in sticks}
+    total = sum(levels.values())
+    share = (sum(levels[n] for n in names if n in levels) / total if total > 0 else
+             sum(n in levels for n in names) / len(sticks))
+    return np.where(v == 0.0, share * hold, out)

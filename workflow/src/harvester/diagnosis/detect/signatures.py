@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from harvester.inference.map_fit import BaselineState
+from harvester.model import stick
 from harvester.model.priors import REFERENCE_DEVICE, DeviceScale
 from harvester.model.simulate import simulate
 from harvester.model.structures import Layout
@@ -110,10 +111,12 @@ def motion_scale(state: BaselineState, window: tuple[int, int], f_high: float) -
 def candidate_terms(structure_terms: tuple[str, ...], allowed: tuple[str, ...] | None = None
                     ) -> list[str]:
     """Library terms that can be added to a structure: nameable (``Term.nameable``), not
-    already in it and, for a refinement of another law (``Term.refines``), with that law in
-    the structure."""
+    already in it, for a refinement of another law (``Term.refines``) with that law in
+    the structure, and one the integrator takes beside it (a dry friction that sticks
+    with no coupling or path-driven state: ``harvester.model.stick.compatible``)."""
     names = [t for t in TERMS if t not in structure_terms and TERMS[t].nameable
-             and (not TERMS[t].refines or set(TERMS[t].refines) & set(structure_terms))]
+             and (not TERMS[t].refines or set(TERMS[t].refines) & set(structure_terms))
+             and stick.compatible([TERMS[n] for n in structure_terms + (t,)])]
     if allowed is not None:
         unknown = [t for t in allowed if t not in TERMS]
         if unknown:

@@ -43,7 +43,7 @@ import numpy as np
 from harvester.data.units import SI, Units
 from harvester.diagnosis.size.latent import LatentForce
 from harvester.diagnosis.size.views import EffectForce, parameter_values
-from harvester.model.term_forces import term_force
+from harvester.model.term_forces import named_force
 from harvester.model.structures import ModelStructure
 from harvester.model.terms import term
 
@@ -306,21 +306,23 @@ def term_force_rms(problem, improved: ModelStructure, samples: np.ndarray,
     generator the truth's RMS over 1-29.9 s and over 1-40 s differed by -7.7 % to +6.2 %.
     Its own path, not the smoother's: a sign law along a path uncertain by a few mm/s never
     sticks (Coulomb 6 N that sticks 28 % of the time gave an RMS of 5.7 N along the
-    smoothed states against 5.2 N along the true path)."""
+    smoothed states against 5.2 N along the true path). A friction that sticks carries, where
+    the path is stuck, the holding force (``term_forces.named_force``)."""
     other = dataclasses.replace(problem, structure=improved)
     rows = np.asarray(samples, dtype=float)
     rows = rows[np.unique(np.linspace(0, len(rows) - 1, min(draws, len(rows))).astype(int))]
     u, start = own_span(problem, record_input)
     sim = other.simulate(rows, u)
     yb = u if problem.input_kind == "base_acc" else np.zeros_like(u)
-    terms = [term(n) for n in ([term_name] if isinstance(term_name, str) else term_name)]
+    names = (term_name,) if isinstance(term_name, str) else tuple(term_name)
+    layout = improved.layout
     forces = []
     for i in np.flatnonzero(sim.ok):
         values = parameter_values(improved, rows[i, :len(improved.free_parameters)],
                                   problem.known)
-        forces.append(sum(term_force(t, values, sim.rel_disp[i], sim.rel_vel[i],
-                                     sim.rel_acc[i], yb, problem.dt)[0, start:]
-                          for t in terms))
+        drive = -values["m"] * u if problem.input_kind == "base_acc" else u
+        forces.append(named_force(layout, values, sim.rel_disp[i], sim.rel_vel[i],
+                                  sim.rel_acc[i], yb, drive, problem.dt, names)[0, start:])
     if not forces:
         raise RuntimeError(f"{improved.name} cannot be simulated at its posterior samples")
     return OwnForce(_median_interval([float(np.sqrt(np.mean(f**2))) for f in forces]),

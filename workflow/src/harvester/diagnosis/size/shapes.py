@@ -48,7 +48,7 @@ from scipy import optimize, signal, special, stats
 from harvester.diagnosis.size.latent import LatentForce
 from harvester.model.term_forces import term_force
 from harvester.model.structures import structure
-from harvester.model.terms import TERMS, is_friction, term
+from harvester.model.terms import STICKING_FRICTION, TERMS, is_friction, term
 
 #: Points of each scanned parameter's grid before the refinement.
 SCAN_POINTS = 40
@@ -716,11 +716,14 @@ def slow_shapes(lf: LatentForce, shapes: Sequence[Shape]) -> frozenset:
 def library_terms(shape: str) -> tuple[str, ...]:
     """The library's terms whose force has ``shape`` (a shape's name); none for a shape
     outside the library. Friction on the ground is the same term acting on the mass's own
-    velocity (``topology``)."""
+    velocity (``topology``). Stick and slip is the shape of the friction laws that hold
+    (``STICKING_FRICTION`` and their refinements), a smooth law's force creeps instead."""
     friction = tuple(name for name, t in TERMS.items() if is_friction(t))
+    sticking = tuple(name for name, t in TERMS.items() if name in STICKING_FRICTION
+                     or set(t.refines) & set(STICKING_FRICTION))
     return {"odd in z": ("cubic_stiffness", "end_stop"), "damping": ("quadratic_damping",),
             "friction": friction, "loop": friction, "friction on the ground": friction,
-            "loop on the ground": friction, "stick-slip on the ground": friction,
+            "loop on the ground": friction, "stick-slip on the ground": sticking,
             "inertial": ("inertia_error",)}.get(shape, ())
 
 

@@ -31,6 +31,13 @@ of eq. 1). Kinds of term and the signature of their force law:
               ``masses`` take the modal mass out of the rigid part's
 ``coupling``  a dead zone between the mass and the screw-side inertia (states d, d'):
               f_b = force(d, d', M, m, *params) transmitted between them
+``stick``     dry friction that holds, on the screw-side velocity w: while sliding,
+              f = sgn(w) force(|w|, *params) (the magnitude at speed |w| >= 0); stuck
+              (w = 0 exactly) while the force it must supply stays within the holding level
+              static(*params) (N). The stick terms of a structure add their magnitudes and
+              their levels; the integrator switches between the stuck and sliding equations
+              at events located within the step (``harvester.model.codegen``,
+              ``docs/sticking-friction.md``)
 """
 
 from __future__ import annotations
@@ -57,7 +64,7 @@ V_BOUND = 1.0
 Z_PER_V = 1.0 / (2.0 * np.pi * 0.5)
 Z_BOUND = Z_PER_V * V_BOUND
 
-KINDS = ("screw", "mass", "inertia", "mode", "coupling")
+KINDS = ("screw", "mass", "inertia", "mode", "coupling", "stick")
 
 #: The device quantities a sidecar may state that a term may imply (``Term.device``).
 DEVICE_QUANTITIES = ("M", "m", "k")
@@ -157,6 +164,12 @@ class Term:
     parameter's value (a mapping; arrays over posterior draws) returning {quantity: value}:
     an inertia error's M + dM and m + m_share dM. The diagnosis holds them against the
     sidecar (``diagnosis.name.plausibility``); None: the term implies none of them.
+    ``static`` (a ``stick`` term): its share of the holding level (N), a function of its
+    parameters. ``transition`` (a ``stick`` term whose law changes fast at low speed, a
+    Stribeck decay): (speed, slope) = transition(*params), the speed (m/s) below which the
+    law changes and its steepest slope there (N s/m); the integrator cuts its sub-steps to
+    that slope only while sliding slower (``harvester.model.stick``), so ``rate_bound`` leaves
+    it out.
     """
 
     name: str
@@ -171,6 +184,8 @@ class Term:
     state_rates: Callable | None = None
     masses: Callable | None = None
     displacement_update: Callable | None = None
+    static: Callable | None = None
+    transition: Callable | None = None
     refines: tuple[str, ...] = ()
     alike: tuple[str, ...] = ()
     limits: tuple[tuple[str, str, str], ...] = ()
@@ -202,12 +217,16 @@ BASE_PARAMETERS: tuple[Parameter, ...] = (
 #: Laws of sliding friction (Dahl's saturates to Coulomb's): what a Stribeck excess or a
 #: direction-dependent part refines.
 SLIDING_FRICTION: tuple[str, ...] = ("tanh_friction", "coulomb_friction", "hysteresis")
+#: Laws of dry friction that hold (``stick`` kind): what a sticking Stribeck excess refines.
+STICKING_FRICTION: tuple[str, ...] = ("sticking_friction",)
 
 
 def is_friction(t: Term) -> bool:
     """Whether a term is a friction law: a sliding law (``SLIDING_FRICTION``, Dahl's
-    pre-sliding ``hysteresis`` among them) or a refinement of one (Stribeck, asymmetry)."""
-    return t.name in SLIDING_FRICTION or bool(set(t.refines) & set(SLIDING_FRICTION))
+    pre-sliding ``hysteresis`` among them; ``STICKING_FRICTION``) or a refinement of one
+    (Stribeck, asymmetry)."""
+    sliding = SLIDING_FRICTION + STICKING_FRICTION
+    return t.name in sliding or bool(set(t.refines) & set(sliding))
 
 
 def check_term(t: Term) -> None:
@@ -228,6 +247,12 @@ def check_term(t: Term) -> None:
     if t.displacement_update is not None and not (
             t.kind == "screw" and t.n_states == 1 and callable(t.displacement_update)):
         problems.append("displacement_update is for a screw term with one state")
+    if (t.kind == "stick") != callable(t.static):
+        problems.append("a stick term, and only one, gives static (its holding level)")
+    if t.transition is not None and t.kind != "stick":
+        problems.append("transition is for a stick term")
+    if t.kind == "stick" and t.n_states:
+        problems.append("a stick term has no states of its own")
     if t.kind in ("inertia", "mode") and not callable(t.masses):
         problems.append(f"an {t.kind} term needs masses")
     if t.device is not None and not callable(t.device):
