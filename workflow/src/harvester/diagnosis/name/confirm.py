@@ -159,6 +159,23 @@ class CandidateResult:
     at_prior_edge: dict[str, str] = field(default_factory=dict)
     #: the stated device quantities its posterior implies (``plausibility``)
     device: list[Implied] = field(default_factory=list)
+    #: displacements of the term the record does not resolve: name -> (posterior median,
+    #: the record's resolution), both m (:func:`unresolved`)
+    unresolved: dict[str, tuple[float, float]] = field(default_factory=dict)
+
+    @property
+    def at_limit(self) -> dict[str, str]:
+        """Its parameters where the term stands for another (``Term.limits``): piled against
+        a bound of the prior, or unresolved (taken at the lower limit)."""
+        return {**self.at_prior_edge, **{n: "lower" for n in self.unresolved}}
+
+    def unresolved_sentence(self) -> str:
+        """Why an unresolved term is not named, in words."""
+        return "; ".join(
+            f"{self.effect}: its {n} of {x * 1e6:.3g} um lies below the {r * 1e6:.3g} um the "
+            "record resolves (its output noise at the likelihood's band): a contact stiffer "
+            "than the record can see, taken as its limit, not named"
+            for n, (x, r) in self.unresolved.items())
 
     @property
     def contradicted(self) -> list[Implied]:
@@ -195,6 +212,8 @@ class CandidateResult:
                 "accepted": self.accepted, "named": self.named,
                 "indistinguishable_from": self.indistinguishable_from,
                 "at_prior_edge": self.at_prior_edge, "implies": self.implies(),
+                "unresolved_m": {n: {"posterior_median": x, "resolution": r}
+                                 for n, (x, r) in self.unresolved.items()},
                 "device": [d.to_dict() for d in self.device],
                 "device_agrees": not self.contradicted,
                 "parameters": summ,
@@ -436,7 +455,7 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
         results.append(result)
         if screened is not None:
             screened.sampled = True
-        order[i + 1:i + 1] = limit_candidates(effect, results[-1].at_prior_edge,
+        order[i + 1:i + 1] = limit_candidates(effect, results[-1].at_limit,
                                               baseline.structure, order)
     results.sort(key=lambda r: -r.delta_log_evidence)
     mark_ties(results, settings)
@@ -535,10 +554,10 @@ def limit_candidates(effect: str, edges: Mapping[str, str], structure: ModelStru
     allowed = set(candidate_terms(structure.terms))
     out = []
     for name, side in edges.items():
-        other = term(effect).limit(name, side)
-        if other and other in allowed and other not in order and other not in out:
-            log.info("%s: %s piles against its %s bound, where the term stands for %s: "
-                     "sampling %s too", effect, name, side, other, other)
+        other = next((o for o in term(effect).limit_terms(name, side) if o in allowed), None)
+        if other and other not in order and other not in out:
+            log.info("%s: %s at its %s limit, where the term stands for %s: sampling %s too",
+                     effect, name, side, other, other)
             out.append(other)
     return out
 
@@ -565,7 +584,8 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     None: sample it (always where it was not screened)."""
     if screened is None:
         return None
-    if top is not None and len([r for r in results if not r.contradicted]) >= top:
+    if top is not None and len([r for r in results
+                                if not (r.contradicted or r.unresolved)]) >= top:
         return f"the round's {top} best by their fits were sampled"
     if screened.pulled and not screened.failed and not any(r.accepted for r in results):
         return (f"its best fit has {screened.pull_phrase()}: its posterior would pile there "
@@ -658,9 +678,37 @@ def judge(effect: str, fit: ModelFit, baseline: ModelFit, settings: ConfirmSetti
     device = candidate_device(effect, fit, settings)
     for d in contradictions(device):
         log.warning("%s: not named: %s", fit.structure.name, d.sentence())
-    return CandidateResult(effect, fit, float(delta), se, float(threshold),
-                           bool(delta > threshold and not edges and not contradictions(device)),
-                           at_prior_edge=edges, device=device)
+    hidden = unresolved(effect, fit)
+    result = CandidateResult(effect, fit, float(delta), se, float(threshold),
+                             bool(delta > threshold and not edges and not hidden
+                                  and not contradictions(device)),
+                             at_prior_edge=edges, device=device, unresolved=hidden)
+    if hidden:
+        log.warning("%s: %s", fit.structure.name, result.unresolved_sentence())
+    return result
+
+
+def resolution(fit: ModelFit) -> float:
+    """The smallest displacement (m) the record tells from its noise: the output's noise sd
+    (the posterior's median sigma) carried to a displacement at the top of the likelihood's
+    band (sigma / (2 pi f)^order: the displacement itself, or its second derivative). Below
+    it a displacement of the model leaves nothing in the record but the noise."""
+    sigma = float(np.median(fit.samples[:, -1]))
+    order = fit.problem.output_type.order
+    return sigma / (2.0 * np.pi * fit.problem.band_hz) ** order
+
+
+def unresolved(effect: str, fit: ModelFit) -> dict[str, tuple[float, float]]:
+    """The term's displacements (``Term.resolved``: a pre-sliding displacement) whose
+    posterior median lies below what the record resolves (:func:`resolution`): name ->
+    (median, resolution), m. Such a term is a stand-in for its limit (a bristle of 0.1 um
+    on a frame whose lasers see 5 um is a contact that holds), not its own physics."""
+    names = [n for n in term(effect).resolved if n in fit.names]
+    if not names:
+        return {}
+    floor = resolution(fit)
+    medians = {n: float(np.median(fit.samples[:, fit.names.index(n)])) for n in names}
+    return {n: (x, floor) for n, x in medians.items() if x < floor}
 
 
 def candidate_device(effect: str, fit: ModelFit, settings: ConfirmSettings) -> list[Implied]:
@@ -677,8 +725,8 @@ def candidate_device(effect: str, fit: ModelFit, settings: ConfirmSettings) -> l
 def becomes(result: CandidateResult, effect: str) -> bool:
     """Whether ``result``'s posterior piles against a bound where its term becomes
     ``effect`` (``Term.limits``): a mode pushed far above the band is the mass error."""
-    return any(term(result.effect).limit(name, side) == effect
-               for name, side in result.at_prior_edge.items())
+    return any(effect in term(result.effect).limit_terms(name, side)
+               for name, side in result.at_limit.items())
 
 
 def mark_ties(results: list[CandidateResult], settings: ConfirmSettings) -> None:
@@ -694,7 +742,7 @@ def mark_ties(results: list[CandidateResult], settings: ConfirmSettings) -> None
     best = accepted[0]
     for r in results:
         if r is best or same_physics(r.effect, best.effect) or becomes(r, best.effect) \
-                or r.contradicted:  # the sidecar tells it apart
+                or r.contradicted or r.unresolved:  # the sidecar, the record tell it apart
             continue
         gap = best.delta_log_evidence - r.delta_log_evidence
         margin = settings.base_threshold + settings.mc_sigmas * np.hypot(best.delta_se,

@@ -231,6 +231,9 @@ def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings
             if r.at_prior_edge:
                 notes.append(f"{r.effect}: the posterior of {', '.join(r.at_prior_edge)} piles "
                              "against its prior's bound; the candidate is not trusted")
+            if r.unresolved:
+                notes.append(f"{r.unresolved_sentence()} ({r.effect} gained "
+                             f"{r.delta_log_evidence:+.1f} nats)")
             if r.refused_for_device:  # the headline says the furthest out, the notes all
                 refused.append(max(r.contradicted, key=lambda d: d.z).sentence())
                 notes.append(f"{'; '.join(d.sentence() for d in r.contradicted)} ({r.effect} "

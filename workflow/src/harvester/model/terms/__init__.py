@@ -164,6 +164,10 @@ class Term:
     parameter's value (a mapping; arrays over posterior draws) returning {quantity: value}:
     an inertia error's M + dM and m + m_share dM. The diagnosis holds them against the
     sidecar (``diagnosis.name.plausibility``); None: the term implies none of them.
+    ``resolved``: parameters that are displacements (m) the record must resolve for the term
+    to be its physics (a pre-sliding displacement): where the posterior puts one below the
+    smallest displacement the record tells from its noise, the term is taken at that
+    parameter's lower limit (``limits``), not named (``diagnosis.name.confirm.unresolved``).
     ``static`` (a ``stick`` term): its share of the holding level (N), a function of its
     parameters. ``transition`` (a ``stick`` term whose law changes fast at low speed, a
     Stribeck decay): (speed, slope) = transition(*params), the speed (m/s) below which the
@@ -189,14 +193,20 @@ class Term:
     refines: tuple[str, ...] = ()
     alike: tuple[str, ...] = ()
     limits: tuple[tuple[str, str, str], ...] = ()
+    resolved: tuple[str, ...] = ()
     nameable: bool = True
     device: Callable[[Mapping], dict] | None = None
     source: str = field(default="", compare=False)  # the file that defines the term
 
     def limit(self, parameter: str, side: str) -> str | None:
         """The term this one stands for where ``parameter`` piles against ``side`` of its
-        prior (``limits``), or None."""
-        return next((t for p, s, t in self.limits if (p, s) == (parameter, side)), None)
+        prior (``limits``: the first listed), or None."""
+        return next(iter(self.limit_terms(parameter, side)), None)
+
+    def limit_terms(self, parameter: str, side: str) -> tuple[str, ...]:
+        """Every term this one stands for at that bound, in the order ``limits`` lists them
+        (a pre-sliding displacement of nothing: friction that sticks, or a sign law)."""
+        return tuple(t for p, s, t in self.limits if (p, s) == (parameter, side))
 
     @property
     def parameter_names(self) -> tuple[str, ...]:
@@ -270,6 +280,8 @@ def check_term(t: Term) -> None:
         except ValueError as err:
             problems.append(f"parameter {p.name}: {err}")
     names = [p.name for p in t.parameters]
+    if not set(t.resolved) <= {p.name for p in t.parameters if p.unit == "m"}:
+        problems.append(f"resolved {t.resolved}: parameters of the term in metres")
     for parameter, side, other in t.limits:
         if parameter not in names or side not in ("lower", "upper") or other == t.name:
             problems.append(f"limit ({parameter}, {side}, {other}): a parameter of the term, "

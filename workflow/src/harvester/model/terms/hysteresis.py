@@ -96,9 +96,12 @@ TERM = Term(
     description="pre-sliding friction with memory and bristle damping (Dahl, LuGre)",
     force=force, state_rates=state_rates, rate_bound=rate_bound,
     displacement_update=displacement_update,
-    # at 1e-4 of the RMS displacement the law is a sign law: a posterior piled there asks
-    # for Coulomb friction (a stick, Karnopp's, say)
-    limits=(("delta_hyst", "lower", "coulomb_friction"),),
+    # at 1e-4 of the RMS displacement the law is a sign law: a posterior piled there, or a
+    # pre-sliding displacement the record does not resolve, asks for dry friction: one that
+    # holds (sticking_friction), or a sign law (Coulomb's)
+    limits=(("delta_hyst", "lower", "sticking_friction"),
+            ("delta_hyst", "lower", "coulomb_friction")),
+    resolved=("delta_hyst",),
     probe=Probe("F_hyst", lambda d: 0.1 * d.force,
                 shapes=lambda d: [{"delta_hyst": f * d.z, "c_hyst": c * d.force / d.v}
                                   for f in (0.001, 0.01, 0.1)
