@@ -165,3 +165,10 @@ def output_floor(u: np.ndarray, y_recorded: np.ndarray, y_chain: np.ndarray,
     a, b = window
     return (periodic_floor(u, y_chain, fs) or quiet_floor(u, y_chain, fs)
             or white_floor(y_recorded[a:b], fs, band_hz))
+
+
+def problem_floor(p) -> Floor | None:
+    """:func:`output_floor` of a likelihood's problem (``inference.map_fit.ChainProblem``):
+    its recorded input and output, the output through its chain, its window and band."""
+    return output_floor(p.base_acc, p.rel_acc, p.measured_chain, p.window, 1.0 / p.dt,
+                        p.band_hz)

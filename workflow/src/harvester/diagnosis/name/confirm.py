@@ -111,6 +111,9 @@ class ConfirmSettings(TMCMCSettings):
     device_sd, device_relative_sd: the uncertainty of the stated device (the sidecar's M_sd,
     m_sd, k_sd as (name, sd) pairs; else the relative sd of the value) that a candidate's
     implied device is held against (``plausibility``).
+
+    noise_floor: the recording's own noise floor (output units, ``detect.floor``; None where
+    none is measured): a term's displacement below it (:func:`unresolved`) is not named.
     """
 
     particles: int = 300
@@ -126,6 +129,7 @@ class ConfirmSettings(TMCMCSettings):
     family: int = 1
     device_sd: tuple[tuple[str, float], ...] = ()
     device_relative_sd: float = DEFAULT_RELATIVE_SD
+    noise_floor: float | None = None
 
     def tmcmc(self, offset: int = 0) -> TMCMCSettings:
         """The sampler's settings alone, the seed moved by ``offset``."""
@@ -173,7 +177,7 @@ class CandidateResult:
         """Why an unresolved term is not named, in words."""
         return "; ".join(
             f"{self.effect}: its {n} of {x * 1e6:.3g} um lies below the {r * 1e6:.3g} um the "
-            "record resolves (its output noise at the likelihood's band): a contact stiffer "
+            "record resolves (its noise floor at the likelihood's band): a contact stiffer "
             "than the record can see, taken as its limit, not named"
             for n, (x, r) in self.unresolved.items())
 
@@ -678,7 +682,7 @@ def judge(effect: str, fit: ModelFit, baseline: ModelFit, settings: ConfirmSetti
     device = candidate_device(effect, fit, settings)
     for d in contradictions(device):
         log.warning("%s: not named: %s", fit.structure.name, d.sentence())
-    hidden = unresolved(effect, fit)
+    hidden = unresolved(effect, fit, settings.noise_floor)
     result = CandidateResult(effect, fit, float(delta), se, float(threshold),
                              bool(delta > threshold and not edges and not hidden
                                   and not contradictions(device)),
@@ -688,25 +692,28 @@ def judge(effect: str, fit: ModelFit, baseline: ModelFit, settings: ConfirmSetti
     return result
 
 
-def resolution(fit: ModelFit) -> float:
-    """The smallest displacement (m) the record tells from its noise: the output's noise sd
-    (the posterior's median sigma) carried to a displacement at the top of the likelihood's
-    band (sigma / (2 pi f)^order: the displacement itself, or its second derivative). Below
-    it a displacement of the model leaves nothing in the record but the noise."""
-    sigma = float(np.median(fit.samples[:, -1]))
+def resolution(fit: ModelFit, noise_floor: float) -> float:
+    """The smallest displacement (m) the record tells from its noise: the recording's own
+    noise floor (RMS over the likelihood's band, output units, ``detect.floor``: measured
+    where the model has no say, so that a model's misfit does not set it) carried to a
+    displacement at the top of that band (floor / (2 pi f)^order: the displacement itself,
+    or its second derivative). Below it a displacement of the model leaves nothing in the
+    record but the noise."""
     order = fit.problem.output_type.order
-    return sigma / (2.0 * np.pi * fit.problem.band_hz) ** order
+    return float(noise_floor) / (2.0 * np.pi * fit.problem.band_hz) ** order
 
 
-def unresolved(effect: str, fit: ModelFit) -> dict[str, tuple[float, float]]:
+def unresolved(effect: str, fit: ModelFit, noise_floor: float | None
+               ) -> dict[str, tuple[float, float]]:
     """The term's displacements (``Term.resolved``: a pre-sliding displacement) whose
     posterior median lies below what the record resolves (:func:`resolution`): name ->
-    (median, resolution), m. Such a term is a stand-in for its limit (a bristle of 0.1 um
-    on a frame whose lasers see 5 um is a contact that holds), not its own physics."""
+    (median, resolution), m. Such a term is a stand-in for its limit (a bristle of 0.1 um on
+    lasers that see 5 um is a contact that holds), not its own physics. None checked where
+    the record's noise floor is not measured (``noise_floor`` None)."""
     names = [n for n in term(effect).resolved if n in fit.names]
-    if not names:
+    if not names or noise_floor is None:
         return {}
-    floor = resolution(fit)
+    floor = resolution(fit, noise_floor)
     medians = {n: float(np.median(fit.samples[:, fit.names.index(n)])) for n in names}
     return {n: (x, floor) for n, x in medians.items() if x < floor}
 

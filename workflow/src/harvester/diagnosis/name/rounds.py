@@ -20,6 +20,7 @@ from harvester.diagnosis.prepare.analysis import Analysis, BaselineStart
 from harvester.inference.map_fit import BaselineState, baseline_state
 from harvester.diagnosis.name.confirm import CandidateResult, confirm, fit_structure
 from harvester.diagnosis.name.fits import ModelFit
+from harvester.diagnosis.detect.floor import problem_floor
 from harvester.diagnosis.detect.scores import Detection, detect
 from harvester.diagnosis.name.rank import RankedCandidate, rank, rivals, to_confirm
 from harvester.diagnosis.name.screen import Screen, screen
@@ -68,6 +69,7 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
     round screens beside its ranking's (the missing force's, ``verdict.nominated_terms``)."""
     now = Current(analysis.structure, start.fit, start.samples, dict(start.priors))
     rounds, notes, unexplained = [], [], False
+    floor = problem_floor(start.detection_problem)  # what a term's displacement must exceed
     baseline_fit = start.fit
     for r in range(settings.rounds + 1):
         rnd = detect_round(analysis, start, now, settings, r)
@@ -94,7 +96,8 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
         effects += [e for e in extra if e not in effects]
         rnd.screen = screen(now.fit, effects, now.priors, scale, det, settings.seed + r)
         # the acceptance shares alpha among every candidate the round could name
-        confirmation = replace(settings.confirmation(), family=len(det.candidates))
+        confirmation = replace(settings.confirmation(), family=len(det.candidates),
+                               noise_floor=None if floor is None else floor.rms)
         rnd.confirmed = confirm(now.fit, effects, now.priors, confirmation, scale,
                                 seed_offset=1000 * (r + 1), detection=det, screen=rnd.screen,
                                 top=settings.top)

@@ -4,7 +4,7 @@ of the baseline's fit against the recording's own noise floor (``detect.floor``)
 
 from __future__ import annotations
 
-from harvester.diagnosis.detect.floor import output_floor
+from harvester.diagnosis.detect.floor import problem_floor
 from harvester.diagnosis.name.fits import ModelFit
 from harvester.diagnosis.name.rounds import Round
 from harvester.diagnosis.name.verdict import FitJudgement
@@ -46,8 +46,7 @@ def fit_judgement(start: BaselineStart, first: Round, before: UnseenFit | None,
     model's, and the baseline's residual over the analysed window against the recording's own
     noise floor in the likelihood's band (``floor.output_floor``)."""
     p = start.detection_problem
-    found = output_floor(p.base_acc, p.rel_acc, p.measured_chain, p.window, 1.0 / p.dt,
-                         p.band_hz)
+    found = problem_floor(p)
     share = None if before is None else 1.0 - before.nrmse ** 2
     improved = None if after is None else 1.0 - after.nrmse ** 2
     return FitJudgement(share, None if before is None else before.nrmse,
