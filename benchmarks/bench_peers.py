@@ -13,6 +13,8 @@ as ``<name>.diagnosis.json`` and reused), pysindy's STLSQ on the restoring force
 thresholds, SysIdentPy's polynomial NARX free run. pysindy and sysidentpy: ``pip install
 -e .[peers]``.
 
+``--kept-only``: the diagnosis's rows only for records whose diagnosis is kept (none is run).
+
 ``--make DIR``: writes literature-grid records into DIR as the grid makes them
 (config/config.yaml: 40 s at 256 Hz, ratio 0.5, the grid's seed offset): each of
 ``--effects`` at seed 0 and the effect-free record at each of ``--free-seeds``.
@@ -78,6 +80,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--effects", nargs="*", default=list(EFFECTS))
     p.add_argument("--free-seeds", nargs="*", type=int, default=[0, 1])
     p.add_argument("--skip-diagnosis", action="store_true", help="the peers only")
+    p.add_argument("--kept-only", action="store_true",
+                   help="the diagnosis only where a <name>.diagnosis.json is kept (none run)")
     p.add_argument("--no-narx", action="store_true", help="without the NARX free run")
     p.add_argument("--csv", type=Path, help="write the per-record rows here")
     args = p.parse_args(argv)
@@ -88,7 +92,9 @@ def main(argv: list[str] | None = None) -> int:
     from harvester.grid.peers import diagnosis_row, peer_rows, read_set, summary
     rows = []
     for rec in read_set(args.set):
-        found = [] if args.skip_diagnosis else [diagnosis_row(rec, run_diagnosis_cached)]
+        kept = rec.path.with_suffix(".diagnosis.json").is_file()
+        run = not args.skip_diagnosis and (kept or not args.kept_only)
+        found = [diagnosis_row(rec, run_diagnosis_cached)] if run else []
         for r in found + peer_rows(rec, narx=not args.no_narx):
             rows.append({"record": rec.path.stem, "correct": " ".join(sorted(rec.correct)),
                          **r, "names": " ".join(r["names"][:3])})

@@ -102,7 +102,7 @@ def _print_heldout(held, errors: dict) -> None:
 
 def _print_benchmark(split, cmp: dict) -> None:
     from harvester.data.public import SILVERBOX_FS, SILVERBOX_INIT, SILVERBOX_TESTS
-    from harvester.study.benchmark import benchmark_table
+    from harvester.study.benchmark import benchmark_table, best_lines
     table = benchmark_table({m: r["idata"] for m, r in cmp["models"].items()}, split, SAMPLES)
     n = len(split.fit.data)
     print(f"Silverbox benchmark (SNLS80mV.mat): fitted on the training multisine's first {n} "
@@ -113,6 +113,8 @@ def _print_benchmark(split, cmp: dict) -> None:
     print(shown.to_string(index=False, float_format=lambda x: f"{x:.3f}"))
     for _, r in table[table["source"] != "this study"].iterrows():
         print(f"  {r['model']}: {r['source']}")
+    for line in best_lines(table):
+        print(line)
 
 
 def _print(diag: dict | None, cmp: dict) -> None:

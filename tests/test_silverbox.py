@@ -206,3 +206,20 @@ def test_the_test_input_held_and_linear_between_samples() -> None:
     assert np.allclose(lin[::4], u) and np.isclose(lin[2], 0.5) and np.isclose(lin[6], 0.0)
     with pytest.raises(ValueError, match="reconstruction"):
         reconstructed(u, "cubic")
+
+
+def test_the_best_on_each_test_is_read_from_the_table() -> None:
+    """The page's summary: per test, our lowest band-limited error beside the lowest
+    published one; rows with the input held, and tests a source does not give, are passed."""
+    from harvester.study.benchmark import BAND_LIMITED, best_lines
+    t = pd.DataFrame([
+        {"model": "cubic", "source": "this study", "input between samples": BAND_LIMITED,
+         "multisine": 0.4, "arrow_full": 0.5, "arrow_no_extrapolation": 0.3},
+        {"model": "cubic", "source": "this study", "input between samples": "held",
+         "multisine": 0.01, "arrow_full": 0.01, "arrow_no_extrapolation": 0.01},
+        {"model": "net", "source": "x", "input between samples": "",
+         "multisine": np.nan, "arrow_full": 1.5, "arrow_no_extrapolation": 0.6}])
+    lines = best_lines(t)
+    assert lines == ["arrow full: cubic 0.500 mV, best published 1.500 mV (net), ratio 3.00",
+                     "arrow no extrapolation: cubic 0.300 mV, best published 0.600 mV (net), "
+                     "ratio 2.00"]

@@ -77,12 +77,6 @@ class Motion:
     fs: float
     f_lo: float
 
-    def highpass(self, x: np.ndarray) -> np.ndarray:
-        """``x`` (columns in time) high-passed as the integrals were (zero phase)."""
-        from scipy.signal import butter, sosfiltfilt
-        return sosfiltfilt(butter(4, self.f_lo, btype="highpass", fs=self.fs, output="sos"),
-                           x, axis=0)
-
 
 def _band_edge(x: np.ndarray, fs: float, share: float = 1e-2) -> float:
     """Lowest frequency (Hz) where the spectrum of ``x`` reaches ``share`` of its peak power."""
@@ -199,14 +193,11 @@ def sindy_names(m: Motion, known: Mapping[str, float], fit: slice, held: slice,
     vt = baseline_width(m, f, fit)
     X, labels = library(m, vt)
     B = baseline_columns(m, vt)
-    # the same high-pass on both sides: the regression holds through it, the integrals'
-    # drift errors (below the cut) leave it
-    Bf, Xf, fh = (m.highpass(x)[fit] for x in (B[:, :-1], X, f))
-    Bf = np.column_stack([Bf, np.ones(len(Bf))])
+    Bf, Xf = B[fit], X[fit]
     scale = np.std(Xf, axis=0)
     scale[scale == 0] = 1.0
     Xr = _residualise(Bf, Xf / scale)
-    fr = _residualise(Bf, fh[:, None])
+    fr = _residualise(Bf, f[fit, None])
     out = []
     for thr in thresholds:
         clock = time.perf_counter()

@@ -117,6 +117,23 @@ def _cells(r: pd.Series) -> str:
                    for c in SILVERBOX_TESTS)
 
 
+def best_lines(table: pd.DataFrame) -> list[str]:
+    """Per test, this study's lowest error (input band-limited) beside the lowest published
+    one and their ratio, read from ``table``."""
+    ours = table[(table["source"] == "this study")
+                 & (table["input between samples"] == BAND_LIMITED)]
+    published = table[table["source"] != "this study"]
+    lines = []
+    for test in SILVERBOX_TESTS:
+        o, p = ours.dropna(subset=[test]), published.dropna(subset=[test])
+        if o.empty or p.empty:
+            continue
+        a, b = o.loc[o[test].idxmin()], p.loc[p[test].idxmin()]
+        lines.append(f"{test.replace('_', ' ')}: {a['model']} {a[test]:.3f} mV, best published "
+                     f"{b[test]:.3f} mV ({b['model']}), ratio {b[test] / a[test]:.2f}")
+    return lines
+
+
 def benchmark_html(table: pd.DataFrame, fit_samples: int) -> str:
     """The table as a report page in the project's style (``harvester.report_style``), with
     how it was made, how to read it, and the quoted figures left out."""
@@ -142,6 +159,8 @@ def benchmark_html(table: pd.DataFrame, fit_samples: int) -> str:
         "rows use the simulator's band-limited interpolation, which looks ahead (non-causal); "
         "the rows below give the same posterior with the input held or linear between "
         "samples. Each published figure was read in the source named beside it.</p>"
+        "<h2>Best on each test</h2><ul>"
+        + "".join(f"<li>{esc(line)}</li>" for line in best_lines(table)) + "</ul>"
         f"<h2>Errors</h2><table><tr><th>model</th><th>kind</th>{head}"
         "<th>input between samples</th><th>same test as ours</th><th>source</th>"
         f"<th>notes</th></tr>{body}</table>"
