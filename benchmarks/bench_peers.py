@@ -97,9 +97,9 @@ def main(argv: list[str] | None = None) -> int:
         found = [diagnosis_row(rec, run_diagnosis_cached)] if run else []
         for r in found + peer_rows(rec, narx=not args.no_narx):
             rows.append({"record": rec.path.stem, "correct": " ".join(sorted(rec.correct)),
-                         **r, "names": " ".join(r["names"][:3])})
+                         **r, "names": " ".join(r["names"])})
             print(f"{rec.path.stem:28s} {r['tool']:22s} {rows[-1]['outcome']:12s} "
-                  f"{rows[-1]['names']:40s} {r['heldout_nrmse'] or float('nan'):7.3f} "
+                  f"{' '.join(r['names'][:3]):40s} {r['heldout_nrmse'] or float('nan'):7.3f} "
                   f"{r['seconds']:8.2f} s", flush=True)
     table = pd.DataFrame(rows)
     if args.csv:

@@ -359,11 +359,15 @@ OUTCOMES = ("right", "tied", "wrong", "missed", "false_alarm", "quiet", "diverge
 
 
 def summary(rows: pd.DataFrame) -> pd.DataFrame:
-    """Per tool: counts of each outcome, records, median held-out NRMSE, seconds per record."""
+    """Per tool: counts of each outcome, records whose names hold a correct one anywhere
+    (``right_anywhere``; rows give ``names`` and ``correct`` as space-separated names),
+    median held-out NRMSE, seconds per record."""
     out = []
     for tool, g in rows.groupby("tool", sort=False):
         counts = {o: int((g["outcome"] == o).sum()) for o in OUTCOMES}
-        out.append({"tool": tool, "records": len(g), **counts,
+        anywhere = sum(bool(set(str(n).split()) & set(str(c).split()))
+                       for n, c in zip(g["names"].fillna(""), g["correct"].fillna("")))
+        out.append({"tool": tool, "records": len(g), **counts, "right_anywhere": anywhere,
                     "heldout_nrmse_median": float(pd.to_numeric(g["heldout_nrmse"],
                                                                 errors="coerce").median()),
                     "heldout_kind": g["heldout_kind"].iloc[0],
