@@ -13,12 +13,12 @@ tail (``diagnosis.analysis.analysis_window``, 25 % held out).
 
 * :func:`sindy_names`: pysindy's STLSQ on the restoring force of eq. (1),
   f = -m y'' - M z'' = c z' + k z + F_c tanh(z'/v_t) + (missing), z and z' integrated from
-  the record in the frequency domain; the baseline's terms (z, z', tanh, its width v_t the
-  least-squares best) kept unpenalised by
-  regressing them out of the force and of every candidate first (Frisch-Waugh-Lovell: the
-  sparse fit of the residuals is the fit with those terms free), the candidates (:data:`LIBRARY`,
-  each a library term's physics) scaled to unit RMS so that a coefficient is the term's RMS
-  force (N) and a threshold a share of the residual force's RMS. Named: the selected
+  the record (:func:`integrate`); the baseline's terms (z, z', tanh with its width v_t the
+  least-squares best, a constant) kept unpenalised by regressing them out of the force and
+  of every candidate first (Frisch-Waugh-Lovell: the sparse fit of the residuals is the fit
+  with those terms free), the candidates (:func:`library`, each a library term's physics)
+  scaled to unit RMS so that a coefficient is the term's RMS force (N) and a threshold a
+  share of the residual force's RMS. Named: the selected
   candidates' library names, largest force first. Held out: z'' predicted from the measured
   z, z' (an equation error, not a simulation).
 * :func:`narx_free_run`: SysIdentPy's polynomial NARX (FROLS) from y'' to z'', simulated
