@@ -20,9 +20,10 @@ prints the RMS error in mV on those held-out samples
 With ``--benchmark`` the same is done on the benchmark's own record, SNLS80mV.mat, as the
 benchmark cuts it (``harvester.data.public.silverbox_benchmark``): fitted on the first
 ``--fit-samples`` of its training multisine, each model simulated for each test's input
-alone, its RMS error (mV) after the first ``SILVERBOX_INIT`` samples printed beside the
-published errors on the same tests that were read in their sources
-(``harvester.study.benchmark.benchmark_table``; none is quoted from memory).
+alone, its RMS error (mV) after the first ``SILVERBOX_INIT`` samples (the test input
+band-limited between samples, then held and linear: ``study.benchmark.reconstruction_errors``)
+printed beside the published errors on the same tests that were read in their sources
+(``harvester.data.published``; none is quoted from memory).
 """
 
 from __future__ import annotations
@@ -100,17 +101,20 @@ def _print_heldout(held, errors: dict) -> None:
 
 
 def _print_benchmark(split, cmp: dict) -> None:
-    from harvester.data.public import SILVERBOX_FS, SILVERBOX_INIT
-    from harvester.study.benchmark import benchmark_table
+    from harvester.data.public import SILVERBOX_FS, SILVERBOX_INIT, SILVERBOX_TESTS
+    from harvester.study.benchmark import benchmark_table, best_lines
     table = benchmark_table({m: r["idata"] for m, r in cmp["models"].items()}, split, SAMPLES)
     n = len(split.fit.data)
     print(f"Silverbox benchmark (SNLS80mV.mat): fitted on the training multisine's first {n} "
           f"samples ({n / SILVERBOX_FS:.2f} s); RMS error (mV) on each test after its first "
           f"{SILVERBOX_INIT} samples, simulated for its input alone:")
-    print(table.drop(columns="source").to_string(index=False,
-                                                 float_format=lambda x: f"{x:.3f}"))
+    shown = table[["model", *SILVERBOX_TESTS, "input between samples"]].copy()
+    shown["input between samples"] = shown["input between samples"].str.split(" ").str[0]
+    print(shown.to_string(index=False, float_format=lambda x: f"{x:.3f}"))
     for _, r in table[table["source"] != "this study"].iterrows():
         print(f"  {r['model']}: {r['source']}")
+    for line in best_lines(table):
+        print(line)
 
 
 def _print(diag: dict | None, cmp: dict) -> None:

@@ -232,7 +232,8 @@ def test_a_group_on_the_silverbox_benchmark_is_scored_on_its_tests(tmp_path):
     model's errors lie below the linear one's on every test (the circuit's cubic spring),
     each in mV against an output of about 50 mV RMS, and the published rows follow with
     their sources."""
-    from harvester.data.public import SILVERBOX_PUBLISHED, SILVERBOX_TESTS
+    from harvester.data.public import SILVERBOX_TESTS
+    from harvester.data.published import SILVERBOX_PUBLISHED
     write_sheet(tmp_path / "sb.tsv", [["sb", str(ROOT / "data/public/silverbox/SNLS80mV.mat"),
                                        "public", "", "training", "sb"]])
     (tmp_path / "config").mkdir()
@@ -246,10 +247,13 @@ def test_a_group_on_the_silverbox_benchmark_is_scored_on_its_tests(tmp_path):
     assert proc.returncode == 0, (proc.stdout + proc.stderr)[-6000:]
     table = pd.read_csv(tmp_path / "results/groups/sb/benchmark.csv")
     assert list(table["model"][:2]) == ["linear", "linear+cubic_stiffness"]
-    ours = table.set_index("model").loc[["linear", "linear+cubic_stiffness"],
-                                        list(SILVERBOX_TESTS)]
+    ours = table.iloc[:2].set_index("model")[list(SILVERBOX_TESTS)]  # input band-limited
     assert (ours.loc["linear+cubic_stiffness"] < ours.loc["linear"]).all()
     assert ((ours > 0.1) & (ours < 30)).all().all()
-    assert list(table["model"][2:]) == [m for m, _, _ in SILVERBOX_PUBLISHED]
+    # the same models with the input held and linear between samples, then the published
+    assert list(table["model"][2:6]) == ["linear", "linear+cubic_stiffness"] * 2
+    held = table.iloc[3][list(SILVERBOX_TESTS)].astype(float)  # the cubic model, input held
+    assert (held > 3 * ours.loc["linear+cubic_stiffness"]).all()
+    assert list(table["model"][6:]) == [p.method for p in SILVERBOX_PUBLISHED]
     html = (tmp_path / "results/groups/sb/benchmark.html").read_text()
-    assert "Beintema" in html and "arrow full (mV)" in html
+    assert "Beintema" in html and "arrow full (mV)" in html and "non-causal" in html

@@ -2,7 +2,7 @@
 benchmark's tests, beside the published errors (benchmark.csv, benchmark.html)."""
 
 from harvester.data.fileio import atomic_path
-from harvester.data.public import SILVERBOX_STUDY_SAMPLES, silverbox_benchmark
+from harvester.data.public import SILVERBOX_STUDY_SAMPLES, SILVERBOX_TESTS, silverbox_benchmark
 from harvester.inference.posterior import read_posterior
 from harvester.runlog import rule_log
 from harvester.study.benchmark import benchmark_html, benchmark_table
@@ -16,4 +16,5 @@ with rule_log(snakemake) as log:  # noqa: F821
         table.to_csv(tmp, index=False, float_format="%.6g")
     with atomic_path(sm.output.html) as tmp:
         tmp.write_text(benchmark_html(table, SILVERBOX_STUDY_SAMPLES))
-    log.info("\n%s", table.drop(columns="source").to_string(index=False))
+    log.info("\n%s", table[["model", *SILVERBOX_TESTS, "input between samples"]].to_string(
+        index=False))

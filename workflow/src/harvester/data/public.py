@@ -48,25 +48,15 @@ FRAME_FILTER_ORDER = 8
 #: data loader makes them (github.com/GerbenBeintema/nonlinear_benchmarks,
 #: ``nonlinear_benchmarks/benchmarks.py``, ``Silverbox``): the multisine's first 75 % to train
 #: on, its last 25 % and the 'arrow' (whose end extrapolates in amplitude; without it, its
-#: first 32000 samples) to test on. Published errors are RMS errors (mV) on the tests after
-#: their first :data:`SILVERBOX_INIT` samples, the model simulated for the test's input alone.
+#: first 32000 samples) to test on. Errors are RMS errors (mV) on the tests after their first
+#: :data:`SILVERBOX_INIT` samples, the model simulated for the test's input alone.
 SILVERBOX_TRAIN = (40650, 105712)
 SILVERBOX_TESTS = {"multisine": (105712, 127400), "arrow_full": (100, 40575),
                    "arrow_no_extrapolation": (100, 32100)}
 #: Samples at a test's start not scored (the loader's state initialisation window).
 SILVERBOX_INIT = 50
-#: Published free-run errors (RMS, mV) on the benchmark's tests (:data:`SILVERBOX_TESTS`), each
-#: read in its source: (method, where it is published, {test: mV}). Both are black-box models;
-#: no grey-box error on these tests was found in a source that could be read here.
-SILVERBOX_PUBLISHED = (
-    ("SS encoder, nx = 8 (deep state-space)", "Beintema, Toth and Schoukens, Nonlinear "
-     "state-space identification using deep encoder networks, L4DC 2021; its notebook's "
-     "output, github.com/GerbenBeintema/SS-encoder-WH-Silver 808f589",
-     {"arrow_full": 5.787, "arrow_no_extrapolation": 2.038}),
-    ("polynomial NARX by FROLS", "SysIdentPy's Silverbox case study, github.com/wilsonrljr/"
-     "sysidentpy 76b75e4, docs/en/user-guide/tutorials/silver-box-system.md",
-     {"multisine": 7.727, "arrow_full": 4.148, "arrow_no_extrapolation": 2.229}),
-)
+# Published free-run errors on these tests, each read in its source: harvester.data.published.
+
 #: The Silverbox's units (its sidecar's ``units``): both channels in volts.
 SILVERBOX_UNITS = {"force": "V", "displacement": "V"}
 #: Its sidecar's ``filtered_at_hz``: no low-pass (:func:`_silverbox_sidecar`). Both channels

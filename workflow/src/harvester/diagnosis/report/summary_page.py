@@ -15,6 +15,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from harvester.report_style import STYLE
+
 #: Sections of the page: (title, [(figure file, how to read it)]), in order. Figures a
 #: diagnosis did not write are left out; figures not listed here go to the last section.
 SECTIONS: tuple[tuple[str, tuple[tuple[str, str], ...]], ...] = (
@@ -133,12 +135,6 @@ def _candidate_rows(doc: Mapping[str, Any]) -> str:
 
 def _num(x: Any) -> str:
     return "-" if x is None else f"{x:.3g}"
-
-
-STYLE = ("body{font-family:sans-serif;max-width:60em;margin:2em auto;color:#222}"
-         ".headline{font-size:1.25em;padding:.6em;border-left:.4em solid #555;background:#f4f4f4}"
-         "figure{margin:1em 0}img{max-width:100%}figcaption{color:#555;font-size:.9em}"
-         "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:.2em .6em}")
 
 
 def summary_page(doc: Mapping[str, Any], figure_dir: str | Path, title: str) -> str:
