@@ -327,7 +327,8 @@ def source(terms: tuple[str, ...], driver: str) -> str:
           if has_stick(objs) else []),
         *imports, "", "",
         f'{jit}, inline="always")', _rhs_source(objs, driver), "", "",
-        *(_stick_source(objs, driver, jit) if has_stick(objs) else
+        *(_stick_source(objs, driver, _SERVO if driver == "servo" else _SAMPLED,
+                        _names(objs), jit) if has_stick(objs) else
           [f"{jit}, nogil=True)", _integrate_source(objs, driver)])])
 
 

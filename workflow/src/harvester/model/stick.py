@@ -210,13 +210,12 @@ def stick_step(ua, uc, h, _s, {ys}, {ks}, {ps}):
     return (_s, {ys}, {ks})"""
 
 
-def _integrate_source(states: list[str], params: list[str], driver: str) -> str:
+def _integrate_source(states: list[str], params: list[str], driver: str, d: dict) -> str:
     """``integrate``: the sub-steps of every particle of a block in turn (``stick_step``),
     the direction and the right-hand side at the step's end carried between steps, z, z',
-    z'' written at the samples, a particle beyond ``BLOW_UP`` flagged and reset."""
-    from harvester.model.codegen import _SAMPLED, _SERVO
+    z'' written at the samples, a particle beyond ``BLOW_UP`` flagged and reset (``d``: the
+    driver's pieces of source, ``codegen``'s)."""
     n = len(states)
-    d = _SERVO if driver == "servo" else _SAMPLED
     load = "\n".join(f"    p_{p} = P[{j}]" for j, p in enumerate(params))
     init = "\n".join(f"    x{j} = np.zeros(C)" for j in range(n))
     carry = "\n".join(f"    kc{j} = np.zeros(C)" for j in range(n + 2))
@@ -268,12 +267,14 @@ def _integrate_source(states: list[str], params: list[str], driver: str) -> str:
 """
 
 
-def stick_source(terms, driver: str, jit: str) -> list[str]:
-    """The generated functions after ``rhs`` of a structure with stick terms (``jit``: the
-    decorator's opening, as ``codegen.source`` writes it)."""
-    from harvester.model.codegen import _names
+def stick_source(terms, driver: str, pieces: dict, names: tuple[list[str], list[str]],
+                 jit: str) -> list[str]:
+    """The generated functions after ``rhs`` of a structure with stick terms, given by
+    ``codegen.source`` (which this module does not import): the ``driver``'s name and its
+    pieces of source, the structure's (parameter, state) ``names``, and ``jit`` the
+    decorator's opening."""
     _check(terms)
-    params, states = _names(terms)
+    params, states = names
     statics = " + ".join(f"_static{i}({', '.join(t.parameter_names)})"
                          for i, t in enumerate(terms) if t.kind == "stick")
     transitions = [f"_transition{i}({', '.join(t.parameter_names)})"
@@ -281,4 +282,4 @@ def stick_source(terms, driver: str, jit: str) -> list[str]:
     step = _step_source(states, params, statics, transitions).replace("{jit}", jit)
     return [f'{jit}, inline="always")', _rk4_source(states, params), "", "",
             f'{jit}, inline="always")', step, "", "",
-            f"{jit}, nogil=True)", _integrate_source(states, params, driver)]
+            f"{jit}, nogil=True)", _integrate_source(states, params, driver, pieces)]
