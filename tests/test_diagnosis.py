@@ -481,10 +481,15 @@ def test_a_candidate_piled_where_it_stands_for_another_term_brings_that_term_in(
 
     tanh = structure("tanh")
     piled = SimpleNamespace(effect="hysteresis", at_prior_edge={"delta_hyst": "lower"})
+    piled.at_limit = piled.at_prior_edge
+    # there the law is dry friction: the one that holds first (Karnopp's stick is one)
     assert limit_candidates("hysteresis", piled.at_prior_edge, tanh, ["hysteresis"]) == [
-        "coulomb_friction"]
+        "sticking_friction"]
     assert limit_candidates("hysteresis", piled.at_prior_edge, tanh,
-                            ["hysteresis", "coulomb_friction"]) == []
+                            ["hysteresis", "sticking_friction"]) == []
+    # beside a term the sticking integrator does not take (backlash), Coulomb's law
+    assert limit_candidates("hysteresis", piled.at_prior_edge, structure("tanh+backlash"),
+                            ["hysteresis"]) == ["coulomb_friction"]
     other_side = SimpleNamespace(effect="hysteresis", at_prior_edge={"delta_hyst": "upper"})
     assert limit_candidates("hysteresis", other_side.at_prior_edge, tanh, ["hysteresis"]) == []
     # a mode's modal mass is part of the stated masses: far above the band it is no mass error
@@ -494,7 +499,9 @@ def test_a_candidate_piled_where_it_stands_for_another_term_brings_that_term_in(
     # and the term it becomes is that term's physics, not a rival explanation of it
     from harvester.diagnosis.name.confirm import becomes
 
-    assert becomes(piled, "coulomb_friction") and not becomes(piled, "cubic_stiffness")
+    other_side.at_limit, mode.at_limit = other_side.at_prior_edge, mode.at_prior_edge
+    assert becomes(piled, "coulomb_friction") and becomes(piled, "sticking_friction")
+    assert not becomes(piled, "cubic_stiffness")
     assert not becomes(other_side, "coulomb_friction")
     assert not becomes(mode, "inertia_error")
 
@@ -523,7 +530,7 @@ def test_a_failed_fit_is_sampled_only_where_a_trusted_importance_estimate_leaves
     assert "single effects' scores" in skip_reason(stop, [], cs, 3, single_scores=True)
     # nor once another candidate is accepted
     from types import SimpleNamespace
-    mode = SimpleNamespace(effect="unmodelled_mode", accepted=True, contradicted=[])
+    mode = SimpleNamespace(effect="unmodelled_mode", accepted=True, contradicted=[], unresolved={})
 
     def estimate():
         raise AssertionError("estimated after another candidate was accepted")

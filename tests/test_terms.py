@@ -22,8 +22,10 @@ def test_every_term_is_complete_and_in_a_file_named_for_it():
 def test_a_terms_limits_name_terms_of_the_library():
     for t in TERMS.values():
         for parameter, side, other in t.limits:
-            assert other in TERMS and t.limit(parameter, side) == other
-    assert TERMS["hysteresis"].limit("delta_hyst", "lower") == "coulomb_friction"
+            assert other in TERMS and other in t.limit_terms(parameter, side)
+    assert TERMS["hysteresis"].limit_terms("delta_hyst", "lower") == ("sticking_friction",
+                                                                      "coulomb_friction")
+    assert TERMS["hysteresis"].limit("delta_hyst", "lower") == "sticking_friction"
     assert TERMS["hysteresis"].limit("delta_hyst", "upper") is None
 
 
