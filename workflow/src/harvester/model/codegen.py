@@ -232,6 +232,18 @@ def _step_source(terms: tuple[Term, ...], driver: str) -> str:
 
 
 #: The servo driver's pieces of ``integrate``: the position loop's force at every sample.
+#: What every integrator writes at a sample: z and z' where asked, and the row z'' goes to
+#: (the sampled and the sticking integrators alike, ``stick.stick_source``).
+WRITES = """        if out_z.shape[0] > 0:
+            for c in range(C):
+                out_z[i, c] = x0[c]
+        if out_v.shape[0] > 0:
+            for c in range(C):
+                out_v[i, c] = x1[c]
+        acc_row = out_acc[i] if out_acc.shape[0] > 0 else scratch
+        last = i == n - 1
+"""
+
 _SERVO = dict(
     head=("def integrate(qg, dist, dt, q0, gtau, kp, kv, n_sub, h, P, out_acc, out_z, "
           "out_v, out_f, ok):"),
@@ -281,15 +293,7 @@ def _integrate_source(terms: tuple[Term, ...], driver: str) -> str:
     half = 0.5 * h
     sixth = h / 6.0
     for i in range(n):
-{d["sample"]}        if out_z.shape[0] > 0:
-            for c in range(C):
-                out_z[i, c] = x0[c]
-        if out_v.shape[0] > 0:
-            for c in range(C):
-                out_v[i, c] = x1[c]
-        acc_row = out_acc[i] if out_acc.shape[0] > 0 else scratch
-        last = i == n - 1
-        {d["interval"]}
+{d["sample"]}{WRITES}        {d["interval"]}
         {d["slope"]}
         for s in range(1 if last else n_sub):
 {d["inputs"]}            row = acc_row if s == 0 else scratch
@@ -327,8 +331,9 @@ def source(terms: tuple[str, ...], driver: str) -> str:
           if has_stick(objs) else []),
         *imports, "", "",
         f'{jit}, inline="always")', _rhs_source(objs, driver), "", "",
-        *(_stick_source(objs, driver, _SERVO if driver == "servo" else _SAMPLED,
-                        _names(objs), jit) if has_stick(objs) else
+        *(_stick_source(objs, driver, {**(_SERVO if driver == "servo" else _SAMPLED),
+                                       "writes": WRITES}, _names(objs), jit)
+          if has_stick(objs) else
           [f"{jit}, nogil=True)", _integrate_source(objs, driver)])])
 
 

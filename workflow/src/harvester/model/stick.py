@@ -242,15 +242,7 @@ def _integrate_source(states: list[str], params: list[str], driver: str, d: dict
 {d["prologue"]}
 {first}    scratch = np.empty(C)
     for i in range(n):
-{d["sample"]}        if out_z.shape[0] > 0:
-            for c in range(C):
-                out_z[i, c] = x0[c]
-        if out_v.shape[0] > 0:
-            for c in range(C):
-                out_v[i, c] = x1[c]
-        acc_row = out_acc[i] if out_acc.shape[0] > 0 else scratch
-        last = i == n - 1
-        {d["interval"]}
+{d["sample"]}{d["writes"]}        {d["interval"]}
         {d["slope"]}
         for s in range(1 if last else n_sub):
 {d["inputs"]}            row = acc_row if s == 0 else scratch
