@@ -142,7 +142,32 @@ def _rhs_source(terms: tuple[Term, ...], driver: str) -> str:
             lines.append(f"    _f_mass += _force{i}(z, {args[i]})")
         elif t.kind == "mode":
             lines.append(f"    _f_mode += _force{i}({st}{args[i]})")
-    derivs = {}
+    derivs: dict[str, str] = {}
+    lines += _acceleration_lines(terms, state_of, args, derivs)
+    for i, t in enumerate(terms):
+        if t.kind == "screw" and t.n_states:
+            out = ", ".join(f"_d{s}" for s in state_of[i])
+            lines.append(f"    {out} = _rates{i}(_w, {''.join(f'{s}, ' for s in state_of[i])}"
+                         f"{args[i]})")
+            derivs.update({s: f"_d{s}" for s in state_of[i]})
+        elif t.kind == "mode":
+            u0, u1 = state_of[i]
+            lines.append(f"    _d{u0}, _d{u1} = _rates{i}({u0}, {u1}, _a, _yb, {args[i]})")
+            derivs.update({u0: f"_d{u0}", u1: f"_d{u1}"})
+    derivs["z"], derivs["v"] = "v", "_a"
+    need = "_f_other, " if sticks else ""
+    lines.append(f"    return _a, {need}" + ", ".join(derivs[s] for s in states))
+    return "\n".join(lines)
+
+
+def _acceleration_lines(terms: tuple[Term, ...], state_of: dict, args: dict,
+                        derivs: dict[str, str]) -> list[str]:
+    """The lines of ``rhs`` that give the mass's acceleration ``_a``: through a coupling (its
+    dead zone's states' rates added to ``derivs``), with stick terms (held or sliding in the
+    direction ``_s``), or plain eq. (1)."""
+    coupling = [i for i, t in enumerate(terms) if t.kind == "coupling"]
+    sticks = [i for i, t in enumerate(terms) if t.kind == "stick"]
+    lines: list[str] = []
     if coupling:
         i = coupling[0]
         d, dd = state_of[i]
@@ -160,20 +185,7 @@ def _rhs_source(terms: tuple[Term, ...], driver: str) -> str:
                   f"    _a = abs(_s) * (_f_other - _s * ({dry})) / _M"]
     else:
         lines.append("    _a = (_drive - _f_screw - _f_mass + _f_mode) / _M")
-    for i, t in enumerate(terms):
-        if t.kind == "screw" and t.n_states:
-            out = ", ".join(f"_d{s}" for s in state_of[i])
-            lines.append(f"    {out} = _rates{i}(_w, {''.join(f'{s}, ' for s in state_of[i])}"
-                         f"{args[i]})")
-            derivs.update({s: f"_d{s}" for s in state_of[i]})
-        elif t.kind == "mode":
-            u0, u1 = state_of[i]
-            lines.append(f"    _d{u0}, _d{u1} = _rates{i}({u0}, {u1}, _a, _yb, {args[i]})")
-            derivs.update({u0: f"_d{u0}", u1: f"_d{u1}"})
-    derivs["z"], derivs["v"] = "v", "_a"
-    need = "_f_other, " if sticks else ""
-    lines.append(f"    return _a, {need}" + ", ".join(derivs[s] for s in states))
-    return "\n".join(lines)
+    return lines
 
 
 def _exact_states(terms: tuple[Term, ...]) -> tuple[dict[int, int], str, str]:

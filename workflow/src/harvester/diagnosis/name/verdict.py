@@ -346,16 +346,16 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
     sizes = missing.sizes if missing is not None else []
     little = explains_little(sizes, fit.library_share())
     relevant = not sizes or any(not s.negligible and not s.little for s in sizes)
+    shown = mismatch_shown(fit, missing)
     verdict = decide_verdict(first.p_value, found.accepted and relevant,
                              settings.unexplained_alpha, explained=fit.explained,
                              min_explained=settings.min_explained_share,
-                             above_floor=above, within_floor=within,
-                             shown=mismatch_shown(fit, missing))
+                             above_floor=above, within_floor=within, shown=shown)
     notes, unexplained = list(found.notes), found.unexplained
     notes += [f"detectable but negligible: {s.sentence()}" for s in sizes if s.negligible]
     notes += little
     if (first.p_value < settings.unexplained_alpha and not (found.accepted and relevant)
-            and mismatch_shown(fit, missing) is False):
+            and shown is False):
         notes.append(f"the detection's p = {first.p_value:.3g} is below "
                      f"{settings.unexplained_alpha:g}, but the residual lies within the noise "
                      f"floor ({fit.ratio:.3g} x) and the missing force within its uncertainty: "
@@ -370,6 +370,20 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
         unexplained = True
         notes.append(f"the residual is {fit.ratio:.3g} x the recording's noise floor "
                      f"({fit.floor.method}): a mismatch that no library effect explains")
+    notes += context_notes(verdict, first, fit, baseline, settings, missing)
+    return replace(found, verdict=verdict, unexplained=bool(unexplained), notes=notes, fit=fit,
+                   headline=headline(verdict, found, fit, baseline, limit, missing,
+                                     settings.units))
+
+
+def context_notes(verdict: str, first: Detection, fit: FitJudgement, baseline: str,
+                  settings: DiagnosisSettings, missing: MissingForce | None) -> list[str]:
+    """What the verdict stands beside, in words: a weak mismatch or a prior conflict left
+    under an adequate verdict, a noise floor that limits what any model explains, a missing
+    force the smoother could not read or that stands out below the bar, a line it leaves, no
+    floor measured."""
+    limit, within = settings.floor_ratio, fit.within(settings.floor_ratio)
+    notes: list[str] = []
     if first.significant and verdict == "adequate":
         notes.append(f"weak mismatch (p = {first.p_value:.3g}) that no library effect explains "
                      f"by evidence; below the bar for an unexplained verdict "
@@ -399,9 +413,7 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
         notes.append("no noise floor of the recording's own could be measured (no repeated "
                      "periods, quiet lead-in or white band): the verdict rests on the "
                      "detection's replicates and on the share of unseen data explained")
-    return replace(found, verdict=verdict, unexplained=bool(unexplained), notes=notes, fit=fit,
-                   headline=headline(verdict, found, fit, baseline, limit, missing,
-                                     settings.units))
+    return notes
 
 
 def _level(effect: str, fit: ModelFit | None, units: Units = SI) -> str:
