@@ -58,13 +58,7 @@ def against_reference() -> None:
 
 def against_karnopp() -> None:
     print("2. the literature generator's Karnopp element as its stick band narrows")
-    dev = lit.draw_device(np.random.default_rng(3))
-    tb = lit.TimeBase(256.0, 8 * 256)
-    tg = np.arange(2 * tb.n_int + 8) * tb.h_int / 2
-    y2 = 0.25 * dev.peak_base_acc * np.minimum(tg / 0.5, 1) ** 2 * (
-        0.7 * np.sin(2 * np.pi * 0.8 * dev.f_n * tg)
-        + 0.3 * np.sin(2 * np.pi * 1.7 * dev.f_n * tg + 0.4))
-    v_rms = np.std(lit.simulate(lit.NONE, dev.params(), y2, tb, 4)[2])
+    dev, tb, y2, v_rms = ed.karnopp_drive(3)
     sim = simulate(Layout.of(["sticking_friction", "sticking_stribeck"]),
                    [dev.M, dev.m, dev.k, dev.c, dev.F_c, 0.5 * dev.F_c, 1e-3 * v_rms, 2.0],
                    y2[:2 * tb.n_int:2], tb.h_int)

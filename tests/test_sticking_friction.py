@@ -194,13 +194,7 @@ def test_karnopp_element_converges_to_the_sticking_law():
     sticking_friction + sticking_stribeck with the same levels and a Stribeck velocity of
     1e-3 of it (the jump), driven by the same base acceleration at the generator's rate."""
     from harvester.synthetic import literature as lit
-    dev = lit.draw_device(np.random.default_rng(3))
-    tb = lit.TimeBase(256.0, 8 * 256)
-    tg = np.arange(2 * tb.n_int + 8) * tb.h_int / 2
-    y2 = 0.25 * dev.peak_base_acc * np.minimum(tg / 0.5, 1) ** 2 * (
-        0.7 * np.sin(2 * np.pi * 0.8 * dev.f_n * tg)
-        + 0.3 * np.sin(2 * np.pi * 1.7 * dev.f_n * tg + 0.4))
-    v_rms = np.std(lit.simulate(lit.NONE, dev.params(), y2, tb, 4)[2])
+    dev, tb, y2, v_rms = ed.karnopp_drive(3)
     p = dev.params()
     p[lit.E:lit.E + 3] = 1.0, 1.5, 1e-4 * v_rms
     _, z, v = lit.simulate(lit.KARNOPP, p, y2, tb, 8)
