@@ -254,8 +254,25 @@ def _diagnose_parser(sub) -> None:
     d.add_argument("--candidates", nargs="+", metavar="TERM", type=_term_name,
                    help="library terms considered as missing (default: every term; "
                         "`harvester terms` lists them)")
+    d.add_argument("--budget", type=_budget, metavar="SECONDS", default=argparse.SUPPRESS,
+                   help="the diagnosis's time budget: past it no candidate is sampled further "
+                        "and diagnosis.json says what was not decided (default: 120 s + 4 s "
+                        "per second of the recording, at least 150; none: no budget)")
     d.add_argument("--fast", action="store_true", help="cheaper settings (for grids)")
     d.add_argument("--no-figures", action="store_true", help="write diagnosis.json only")
+
+
+def _budget(text: str) -> float | None:
+    """--budget's value: seconds (> 0) or "none"."""
+    if text.strip().lower() == "none":
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"expected seconds > 0 or 'none', got {text!r}")
+    return value
 
 
 # --------------------------------------------------------------------------- shared steps
@@ -464,6 +481,8 @@ def _diagnosis_settings(args: argparse.Namespace):
     _quiet_pymc()
     overrides = {k: v for k, v in {"particles": args.particles, "rounds": args.rounds,
                                    "top": args.top}.items() if v is not None}
+    if hasattr(args, "budget"):  # else the library's default, from the recording's length
+        overrides.update(budget=args.budget is not None, budget_s=args.budget)
     if args.candidates:
         overrides["candidates"] = tuple(args.candidates)
     overrides.update(chains=args.chains, seed=args.seed, lowpass_hz=args.filtered_at,

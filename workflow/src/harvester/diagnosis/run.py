@@ -30,6 +30,8 @@ import pandas as pd
 from harvester.data.signals import uniform_step
 from harvester.diagnosis.detect.quick import quick_detect
 from harvester.diagnosis.detect.signatures import candidate_terms
+from harvester.diagnosis.name.budget import (Timeline, Unfinished, budget_dict, spent,
+                                             with_deadline)
 from harvester.diagnosis.name.fits import ModelFit
 from harvester.diagnosis.name.rounds import Round, run_rounds
 from harvester.diagnosis.name.verdict import (Conclusion, FitJudgement, Tie, conclude,
@@ -86,6 +88,7 @@ class Diagnosis:
     fit_judgement: FitJudgement | None = None
     missing_force: MissingForce | None = None
     withheld: list[str] = field(default_factory=list)
+    budget: dict = field(default_factory=dict)  # ``name.budget.budget_dict``
 
     @property
     def indistinguishable(self) -> list[list[str]]:
@@ -102,7 +105,8 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
              posterior: az.InferenceData | None = None,
              validation: pd.DataFrame | None = None,
              settings: DiagnosisSettings = DiagnosisSettings(),
-             out_dir: str | Path | None = None, source: str = "<recording>") -> Diagnosis:
+             out_dir: str | Path | None = None, source: str = "<recording>",
+             started: float | None = None) -> Diagnosis:
     """Diagnose ``recording`` against ``baseline``; write diagnosis.json and figures to
     ``out_dir`` if given.
 
@@ -111,13 +115,22 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
     ``posterior``: the baseline's posterior (InferenceData from ``identify``) to diagnose; when
     None the baseline is sampled here. ``validation``: an unseen record (same format) for the
     before/after comparison; without it the recording's last ``holdout_fraction`` is held out.
+    ``started``: when the time budget began (``time.time()``; default now).
     """
-    clock = time.perf_counter()
-    analysis = prepare(recording, validation, baseline, known, settings, source)
-    start = start_baseline(analysis, priors, posterior, settings)
-    passes = _pass(analysis, start, settings)
-    passes = second_pass(analysis, start, settings, passes)
+    clock, timeline = time.perf_counter(), Timeline()
+    record_s = float(np.ptp(recording["time"].to_numpy()))
+    settings = with_deadline(settings, record_s, started)
+    if started is not None:  # the recording read, the friction's contact and priors chosen
+        timeline.steps.append(("input", max(time.time() - started, 0.0)))
+    with timeline.step("prepare"):
+        analysis = prepare(recording, validation, baseline, known, settings, source)
+    with timeline.step("baseline"):
+        start = start_baseline(analysis, priors, posterior, settings)
+    passes = _pass(analysis, start, settings, timeline=timeline)
+    passes = second_pass(analysis, start, settings, passes, timeline)
     rounds, found = passes.rounds, passes.found
+    found = replace(found, unfinished=found.unfinished + passes.cut)
+    search_s = time.perf_counter() - clock
     found = judge(found, rounds[0].detection, passes.fit, analysis.structure.name, settings,
                   passes.missing)
     missing = passes.missing
@@ -125,6 +138,7 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
                       settings, analysis.notes + passes.notes + found.notes + passes.more,
                       time.perf_counter() - clock)
     diag.missing_force = missing
+    diag.budget = budget_dict(settings, record_s, search_s, found.unfinished, timeline)
     caveat = mass_size_caveat(analysis, diag)
     if caveat:
         log.info("%s", caveat)
@@ -162,7 +176,7 @@ def diagnose_given(given: DiagnosisInput, baseline: str,
     input is refused before anything is written): its notes open the diagnosis's."""
     diag = diagnose(given.recording, baseline, given.known, given.priors,
                     validation=given.validation, settings=given.settings,
-                    source=given.source)
+                    source=given.source, started=given.started)
     diag.notes[:0] = given.notes
     if out_dir is not None:
         write(diag, out_dir)
@@ -182,24 +196,32 @@ class _Pass:
     missing: MissingForce | None
     notes: list[str]
     more: list[str]
+    cut: list[Unfinished] = field(default_factory=list)  # a second pass the budget stopped
 
 
 def _pass(analysis: Analysis, start: BaselineStart, settings: DiagnosisSettings,
-          nominated: tuple[str, ...] = ()) -> _Pass:
+          nominated: tuple[str, ...] = (), timeline: Timeline | None = None,
+          label: str = "") -> _Pass:
     """The rounds (``nominated`` effects screened in the first), their conclusion, the fit on
-    unseen data and the missing force."""
-    rounds, baseline_fit, unexplained, notes = run_rounds(analysis, start, settings, nominated)
+    unseen data and the missing force; each step timed on ``timeline`` (``label`` before
+    its name)."""
+    timeline = timeline or Timeline()
+    with timeline.step(f"{label}rounds"):
+        rounds, baseline_fit, unexplained, notes = run_rounds(analysis, start, settings,
+                                                              nominated)
     found = conclude(rounds, unexplained, settings, analysis.f_high)
-    before, after, more = unseen_comparison(analysis, start, found.improved_fit, settings)
+    with timeline.step(f"{label}fit on unseen data"):
+        before, after, more = unseen_comparison(analysis, start, found.improved_fit, settings)
     fit = fit_judgement(start, rounds[0], before, after)
-    missing, missing_notes = estimate_missing_force(analysis, rounds[0].state, found, settings,
-                                                    fit.floor, start)
+    with timeline.step(f"{label}missing force"):
+        missing, missing_notes = estimate_missing_force(analysis, rounds[0].state, found,
+                                                        settings, fit.floor, start)
     return _Pass(rounds, baseline_fit, found, (before, after), fit, missing, notes,
                  more + missing_notes)
 
 
 def second_pass(analysis: Analysis, start: BaselineStart, settings: DiagnosisSettings,
-                first: _Pass) -> _Pass:
+                first: _Pass, timeline: Timeline | None = None) -> _Pass:
     """The second pass, where the first's missing force has the shape of library terms that
     its rounds did not try (``verdict.nominated_terms``: the detection's scores did not point
     to them): the rounds again with those terms screened in the first round, and a note
@@ -209,10 +231,16 @@ def second_pass(analysis: Analysis, start: BaselineStart, settings: DiagnosisSet
     if not nominated:
         return first
     best = first.missing.description.determined[0]
+    if spent(settings):
+        log.info("the missing force is %s: the library's %s not tried, and the time budget "
+                 "is spent: no second pass", best.name, ", ".join(nominated))
+        first.cut.append(Unfinished("second pass", f"{', '.join(nominated)} (the missing "
+                                    f"force is {best.name})", "not screened"))
+        return first
     log.info("the missing force is %s (%.0f sd out): the library's %s, of that shape, "
              "not tried; the rounds again with %s screened", best.name, best.standing_sd,
              ", ".join(nominated), "it" if len(nominated) == 1 else "them")
-    again = _pass(analysis, start, settings, tuple(nominated))
+    again = _pass(analysis, start, settings, tuple(nominated), timeline, "second pass: ")
     again.notes.append(f"{', '.join(nominated)} screened because the missing force is "
                        f"{best.name} ({best.standing_sd:.0f} sd out), though the "
                        "detection's scores did not point to "

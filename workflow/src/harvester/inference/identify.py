@@ -36,6 +36,9 @@ class TMCMCSettings:
     #: "prior": every particle from the prior (Ching and Chen); "map": half of them at the
     #: model's MAP with its Laplace covariance widened (:func:`map_start`)
     start: str = "prior"
+    #: wall-clock time (``time.time()``, s) past which a run stops (``tmcmc.OutOfTime``): a
+    #: caller's time budget, set at run time (never from a config); None: none
+    deadline: float | None = None
 
     def __post_init__(self) -> None:
         if self.start not in TMCMC_STARTS:
@@ -44,7 +47,8 @@ class TMCMCSettings:
 
     @classmethod
     def from_config(cls, cfg: Mapping) -> "TMCMCSettings":
-        return cls(**{k: cfg[k] for k in cls.__dataclass_fields__ if k in cfg})
+        return cls(**{k: cfg[k] for k in cls.__dataclass_fields__
+                      if k in cfg and k != "deadline"})
 
     def run_arguments(self) -> dict:
         """These settings as the keyword arguments of ``tmcmc.run_tmcmc``."""
@@ -52,7 +56,7 @@ class TMCMCSettings:
                     proposal_scale=self.proposal_scale, target_cov=self.target_cov,
                     mcmc_steps=self.mcmc_steps, max_mcmc_steps=self.max_mcmc_steps,
                     correlation_threshold=self.correlation_threshold,
-                    target_accept=self.target_accept)
+                    target_accept=self.target_accept, deadline=self.deadline)
 
 
 def identify(problem: Problem, priors: Mapping[str, PriorSpec],

@@ -155,6 +155,16 @@ class TMCMCError(RuntimeError):
     """TMCMC cannot continue (no particle has a finite likelihood, or a degenerate population)."""
 
 
+class OutOfTime(RuntimeError):
+    """TMCMC stopped at its ``deadline`` (a caller's time budget): the chain, the stage and the
+    tempering exponent it had reached; no posterior and no evidence."""
+
+    def __init__(self, chain: int, stage: int, beta: float):
+        self.chain, self.stage, self.beta = chain, stage, float(beta)
+        super().__init__(f"TMCMC stopped at its deadline: chain {chain}, stage {stage}, "
+                         f"beta {self.beta:.3g}")
+
+
 # --------------------------------------------------------------------------------------------
 # The algorithm's formulas, as plain functions of the population arrays
 # --------------------------------------------------------------------------------------------
@@ -548,6 +558,11 @@ class TMCMC(SMC_KERNEL):
     reference : Reference or None, default None
         Temper from this reference distribution instead of the prior (module docstring). None
         gives Ching & Chen's path, unchanged to the last bit.
+    deadline : float or None, default None
+        Wall-clock time (``time.time()``, s) past which the run stops with `OutOfTime`,
+        checked before each stage and each Metropolis move (a caller's time budget); at
+        beta = 1, whose evidence is complete, it only ends the last stage's settling moves
+        once ``mcmc_steps`` are made. None: no deadline.
     log : logging.Logger or callable(str) or None, default None
         Where the per-stage progress line goes; None means the logger ``harvester.inference.tmcmc`` at
         INFO. A callable must be picklable by cloudpickle if ``cores > 1``. The chain number in
@@ -592,6 +607,7 @@ class TMCMC(SMC_KERNEL):
         target_accept: float | None = None,
         resampling: str = "multinomial",
         reference: Reference | None = None,
+        deadline: float | None = None,
         log: logging.Logger | Callable[[str], None] | None = None,
         **kwargs,
     ):
@@ -625,6 +641,7 @@ class TMCMC(SMC_KERNEL):
         self.mixture_components = int(mixture_components)
         self.mixture: GaussianMixture | None = None
         self.resampling = resampling
+        self.deadline = deadline
         self.log = log
         model = modelcontext(kwargs.get("model"))
         self.population_logp_func = compile_population_logp(model, compile_kwargs)
@@ -718,8 +735,17 @@ class TMCMC(SMC_KERNEL):
 
     # ---- one stage ---------------------------------------------------------------------------
 
+    def past_deadline(self) -> bool:
+        return self.deadline is not None and time.time() > self.deadline
+
+    def check_time(self) -> None:
+        """`OutOfTime` where the deadline has passed."""
+        if self.past_deadline():
+            raise OutOfTime(self.chain, self.iteration, self.beta)
+
     def update_beta_and_weights(self) -> None:
         """Next beta for cov(w) = target_cov; weights; evidence factor S_j = mean(w)."""
+        self.check_time()
         self.iteration += 1
         alive = np.isfinite(self.likelihood_logp)
         if not alive.any():
@@ -794,6 +820,13 @@ class TMCMC(SMC_KERNEL):
         limit = self.max_mcmc_steps * (FINAL_MOVES_FACTOR if settle else 1)
         means = [self._logp_mean_se()[0]]
         while steps < limit:
+            if self.beta >= 1.0 and steps >= self.mcmc_steps and self.past_deadline():
+                # at beta = 1 the evidence is complete: the deadline ends the settling moves
+                self._say(f"TMCMC chain {self.chain}: the last stage's moves stopped at the "
+                          f"deadline after {steps}")
+                break
+            if self.beta < 1.0:
+                self.check_time()
             if use_imh and steps % 2 == 0:
                 got = self._independent_move()
                 imh_accepted += got
@@ -990,7 +1023,7 @@ def run_tmcmc(
     """Sample ``model`` with `TMCMC` and return InferenceData with tidy TMCMC statistics.
 
     ``kernel_kwargs`` go to `TMCMC` (``proposal_scale``, ``target_cov``, ``mcmc_steps``,
-    ``resampling``, ``reference``, ``log``). ``idata.sample_stats`` is replaced by `tidy_sample_stats`:
+    ``resampling``, ``reference``, ``deadline``, ``log``). ``idata.sample_stats`` is replaced by `tidy_sample_stats`:
     ``log_evidence`` per chain, the tempering schedule ``beta`` (chain, stage), acceptance
     rates, likelihood evaluations and wall times; numeric only, so it can be saved to netCDF.
     """

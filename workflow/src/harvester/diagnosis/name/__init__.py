@@ -6,6 +6,7 @@
 ``screen``       the candidates' best fits (MAP), which bound the evidence each can gain
 ``smoothness``   whether a candidate's likelihood is smooth enough to sample
 ``confirm``      TMCMC of the augmented structures, their evidence, ties
+``budget``       the search's time budget: its deadline, what it left unfinished
 ``plausibility`` a candidate's implied device (masses, stiffness) against the sidecar's
                  measurements: a name whose device contradicts them is not given
 ``rounds``       detect -> rank -> screen -> confirm, one effect added per round

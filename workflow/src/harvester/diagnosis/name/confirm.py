@@ -50,6 +50,7 @@ collapsed all the same (:func:`collapsed`) is sampled again from the prior.
 from __future__ import annotations
 
 import logging
+import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
@@ -59,6 +60,7 @@ from harvester.inference.map_fit import ChainProblem, chain_problem
 from harvester.diagnosis.detect.scores import Detection, at_prior_edge
 from harvester.diagnosis.name.fits import (BRIDGE_MIN_SE, MISSED_MODE_NATS, ModelFit, candidate_priors,
                                       prior_dict, scan_factor)
+from harvester.diagnosis.name.budget import OutOfTime, Unfinished, spent
 from harvester.diagnosis.name.screen import Screen
 from harvester.data.sidecar import DEFAULT_RELATIVE_SD
 from harvester.diagnosis.name.plausibility import (Implied, contradictions, implied_device,
@@ -166,6 +168,7 @@ class CandidateResult:
     #: displacements of the term the record does not resolve: name -> (posterior median,
     #: the record's resolution), both m (:func:`unresolved`)
     unresolved: dict[str, tuple[float, float]] = field(default_factory=dict)
+    seconds: float = 0.0  # wall time of its confirmation (TMCMC, or the estimate it rests on)
 
     @property
     def at_limit(self) -> dict[str, str]:
@@ -213,6 +216,7 @@ class CandidateResult:
                 **self.fit.evidence_dict(),
                 "delta_log_evidence": self.delta_log_evidence,
                 "delta_log_evidence_se": self.delta_se, "threshold": self.threshold,
+                "seconds": self.seconds,
                 "accepted": self.accepted, "named": self.named,
                 "indistinguishable_from": self.indistinguishable_from,
                 "at_prior_edge": self.at_prior_edge, "implies": self.implies(),
@@ -319,6 +323,10 @@ def fit_structure(problem: ChainProblem, structure: ModelStructure,
         spread = float(np.ptp(ev)) if len(ev) > 1 else 0.0
         if spread <= settings.agreement_nats or attempt == settings.enlargements:
             break
+        if spent(settings):
+            log.warning("%s: the chains differ by %.2f nats, but the time budget is spent: "
+                        "not sampled again", structure.name, spread)
+            break
         if decisions is not None and not _straddles(ev, decisions, settings.agreement_nats):
             log.info("%s: the chains differ by %.2f nats, but no decision lies within their "
                      "range: not sampled again", structure.name, spread)
@@ -412,50 +420,56 @@ def start_of(effect: str, baseline: ModelFit, detection: Detection | None,
 def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSpec],
             settings: ConfirmSettings, scale: DeviceScale, seed_offset: int = 0,
             detection: Detection | None = None, screen: Screen | None = None,
-            top: int | None = None) -> list[CandidateResult]:
+            top: int | None = None, unfinished: list[Unfinished] | None = None,
+            where: str = "") -> list[CandidateResult]:
     """Sample each augmented structure; evidence against the baseline; acceptance.
     ``detection``: the round's detection, whose scans place the start of candidates with a
     ``Probe.start_shape`` (:func:`candidate_reference`). ``screen``: the candidates' best
     fits (``diagnosis.name.screen``); then they are sampled in its order, at most ``top`` of them,
     and one whose evidence bound rules it out is not sampled (:func:`skip_reason`). Those
     whose best fit lies on a bound their posterior must pile against (``Screened.pulled``)
-    come last: they can only tie with a candidate accepted before them."""
+    come last: they can only tie with a candidate accepted before them. Past the settings'
+    deadline (``budget``) a candidate's TMCMC stops and no further one starts: each is
+    appended to ``unfinished`` (``where``: the round, for its sentence)."""
     fitted = {s.effect: s for s in screen.candidates} if screen is not None else {}
     order, pulled = sampling_order(list(screen.order if screen is not None else effects),
                                    fitted)
     single = detection is not None and not (detection.significant or detection.conflict)
-    results = []
+    results, cut = [], unfinished if unfinished is not None else []
     i = -1
     while i + 1 < len(order):
         i += 1
         effect = order[i]
         screened = fitted.get(effect)
+        late = bool(cut) or spent(settings)
         reason = skip_reason(screened, results, settings, top, baseline.log_evidence_se,
-                             single)
+                             single, estimate=not late)
+        if reason is None and late:
+            reason = "the time budget ran out before it"
         if reason is not None:
-            screened.skipped = reason
-            log.info("%s not sampled: %s", effect, reason)
+            _skipped(screened, effect, reason)
             if effect in pulled:
                 edges = {n: side for n, (side, _) in screened.pulled.items()}
                 order[i + 1:i + 1] = limit_candidates(effect, edges, baseline.structure, order)
+            if reason.startswith("the time budget"):
+                cut.append(Unfinished(where, baseline.structure.with_term(effect).name,
+                                      "not sampled"))
             continue
         log.info("confirming %s (%d of %d)", baseline.structure.with_term(effect).name, i + 1,
                  len(order))
-        result = judged_by_importance(baseline, effect, screened, settings,
-                                      seed_offset + 101 * (i + 1))
-        if result is None and rough(screened):
-            result = judged_rough(baseline, effect, screened, settings,
-                                  seed_offset + 101 * (i + 1))
-            if result is None:
-                screened.skipped = rough_reason(screened)
-                log.warning("%s not sampled: %s", effect, screened.skipped)
-                continue
+        begun = time.perf_counter()
+        try:
+            result = _confirm_one(baseline, effect, screened, priors, settings, scale,
+                                  detection, seed_offset + 101 * (i + 1), results)
+        except OutOfTime as stop:
+            name = baseline.structure.with_term(effect).name
+            cut.append(Unfinished.stopped(where, name, stop))
+            _skipped(screened, effect, f"not finished within the time budget ({stop})")
+            continue
         if result is None:
-            point = screened.point if screened is not None and not screened.failed else None
-            fit = candidate_fit(baseline, effect, priors, settings, scale, detection,
-                                seed_offset + 101 * (i + 1),
-                                decisions(baseline, results, settings), point)
-            result = judge(effect, fit, baseline, settings)
+            _skipped(screened, effect, rough_reason(screened))
+            continue
+        result.seconds = time.perf_counter() - begun
         results.append(result)
         if screened is not None:
             screened.sampled = True
@@ -464,6 +478,31 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
     results.sort(key=lambda r: -r.delta_log_evidence)
     mark_ties(results, settings)
     return results
+
+
+def _skipped(screened, effect: str, reason: str) -> None:
+    """Say (and record on the screened candidate) why ``effect`` was not sampled."""
+    if screened is not None:
+        screened.skipped = reason
+    log.info("%s not sampled: %s", effect, reason)
+
+
+def _confirm_one(baseline: ModelFit, effect: str, screened, priors: Mapping[str, PriorSpec],
+                 settings: ConfirmSettings, scale: DeviceScale, detection: Detection | None,
+                 seed: int, results: list[CandidateResult]) -> CandidateResult | None:
+    """One candidate's result: judged on its importance-sampling estimate where that decides
+    (:func:`judged_by_importance`, :func:`judged_rough`), else by TMCMC (:func:`candidate_fit`);
+    None where its likelihood jumps and no estimate is trusted (not sampled). Raises
+    ``OutOfTime`` past the settings' deadline."""
+    result = judged_by_importance(baseline, effect, screened, settings, seed)
+    if result is None and rough(screened):
+        return judged_rough(baseline, effect, screened, settings, seed)
+    if result is None:
+        point = screened.point if screened is not None and not screened.failed else None
+        fit = candidate_fit(baseline, effect, priors, settings, scale, detection, seed,
+                            decisions(baseline, results, settings), point)
+        result = judge(effect, fit, baseline, settings)
+    return result
 
 
 def judged_by_importance(baseline: ModelFit, effect: str, screened, settings: ConfirmSettings,
@@ -568,7 +607,7 @@ def limit_candidates(effect: str, edges: Mapping[str, str], structure: ModelStru
 
 def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSettings,
                 top: int | None, nested_se: float = BRIDGE_MIN_SE,
-                single_scores: bool = False) -> str | None:
+                single_scores: bool = False, estimate: bool = True) -> str | None:
     """Why a screened candidate (``diagnosis.name.screen.Screened``) need not be sampled: ``top``
     candidates were sampled already, or its evidence bound (``Screened.bound``) or its
     importance-sampling ceiling (``Screened.importance_ceiling``, where trusted) lies below the
@@ -585,7 +624,8 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     even estimated. A candidate whose best fit lies on a bound its posterior must pile
     against (``Screened.pulled``) would not be trusted (:func:`judge`), so it cannot be
     named; it is sampled only where a candidate accepted before it leaves it a tie to make.
-    None: sample it (always where it was not screened)."""
+    None: sample it (always where it was not screened). ``estimate`` False: the reasons that
+    need no importance-sampling estimate only (the time budget is spent)."""
     if screened is None:
         return None
     if top is not None and len([r for r in results
@@ -597,12 +637,12 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     least = settings.acceptance_base + settings.mc_sigmas * float(np.hypot(nested_se,
                                                                            BRIDGE_MIN_SE))
     if screened.failed:  # its bound means nothing; a trusted estimate still does
-        return _failed_fit_reason(screened, results, settings, least, single_scores)
-    return _fitted_reason(screened, results, settings, least)
+        return _failed_fit_reason(screened, results, settings, least, single_scores, estimate)
+    return _fitted_reason(screened, results, settings, least, estimate)
 
 
 def _failed_fit_reason(screened, results: list[CandidateResult], settings: ConfirmSettings,
-                       least: float, single_scores: bool) -> str | None:
+                       least: float, single_scores: bool, estimate: bool = True) -> str | None:
     """:func:`skip_reason` for a candidate whose fit fell below the nested model's: only a
     trusted importance-sampling estimate, and only in a round opened by the family's test
     with nothing accepted yet, can leave it open (``least``: the acceptance threshold)."""
@@ -613,6 +653,8 @@ def _failed_fit_reason(screened, results: list[CandidateResult], settings: Confi
     if accepted:  # not estimated either (100 s for a stiff contact): the next round
         return (f"its fit fell below the nested model's and {accepted[0]} was accepted; "
                 "the next round screens it again")
+    if not estimate:
+        return None
     ceiling = screened.importance_ceiling(settings.mc_sigmas)
     if ceiling is None:
         return (f"its fit fell below the nested model's and {screened.importance_phrase()}"
@@ -624,7 +666,7 @@ def _failed_fit_reason(screened, results: list[CandidateResult], settings: Confi
 
 
 def _fitted_reason(screened, results: list[CandidateResult], settings: ConfirmSettings,
-                   least: float) -> str | None:
+                   least: float, estimate: bool = True) -> str | None:
     """:func:`skip_reason` for a candidate with a usable fit: its evidence bound, then its
     trusted importance-sampling ceiling, against the acceptance threshold ``least`` and the
     best accepted gain less the naming margin."""
@@ -640,6 +682,8 @@ def _fitted_reason(screened, results: list[CandidateResult], settings: ConfirmSe
         if screened.bound < floor:
             return (f"its best fit gains at most {screened.bound:.1f} nats of evidence; "
                     f"{best.effect} gained {best.delta_log_evidence:.1f}")
+    if not estimate:
+        return None
     ceiling = screened.importance_ceiling(settings.mc_sigmas)
     if ceiling is not None and ceiling < max(least, floor):
         return (f"{screened.importance_phrase()}, at most {ceiling:.1f}, below "

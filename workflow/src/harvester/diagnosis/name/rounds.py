@@ -5,19 +5,22 @@ library's effects by how much of it each explains (``rank``), fits the best ``sc
 and their rivals (``rank.rivals``) by MAP for a bound on the evidence each can gain
 (``screen``), samples the best few by that bound by TMCMC, skipping those the bound rules
 out, judges them by evidence (``confirm``), and adopts the best accepted one. It stops when
-nothing is detected, nothing is worth sampling, nothing sampled is accepted, or after
-``settings.rounds`` additions.
+nothing is detected, nothing is worth sampling, nothing sampled is accepted, the time budget
+is spent (``budget``; what it cut is kept on the round), or after ``settings.rounds``
+additions.
 """
 
 from __future__ import annotations
 
 import logging
+import time
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from harvester.diagnosis.prepare.analysis import Analysis, BaselineStart
 from harvester.inference.map_fit import BaselineState, baseline_state
+from harvester.diagnosis.name.budget import Unfinished, spent
 from harvester.diagnosis.name.confirm import CandidateResult, confirm, fit_structure
 from harvester.diagnosis.name.fits import ModelFit
 from harvester.diagnosis.detect.floor import problem_floor
@@ -43,6 +46,8 @@ class Round:
     confirmed: list[CandidateResult] = field(default_factory=list)
     scale: DeviceScale | None = None  # the scales the candidates' priors were read on
     screen: Screen | None = None  # the candidates' best fits, in the order they were sampled
+    unfinished: list[Unfinished] = field(default_factory=list)  # what the budget cut
+    seconds: dict[str, float] = field(default_factory=dict)  # detect, screen, confirm
 
     @property
     def accepted(self) -> CandidateResult | None:
@@ -87,27 +92,21 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
                 notes.append(f"round {r + 1}: mismatch detected (p = {det.p_value:.3g}) but no "
                              "library effect explains enough of it to be worth sampling")
             break
-        if now.fit is None:
+        if now.fit is None:  # the baseline's own sampling: never cut by the budget
             now.fit = fit_structure(start.fit_problem, now.structure, now.priors,
-                                    settings.confirmation())
+                                    replace(settings.confirmation(), deadline=None))
             baseline_fit = baseline_fit or now.fit
-        scale = rnd.scale = motion_scale(rnd.state, analysis.window, det.frame.f_high)
         effects = [c.effect for c in chosen + rivals(rnd.ranked, chosen)]
         effects += [e for e in extra if e not in effects]
-        rnd.screen = screen(now.fit, effects, now.priors, scale, det, settings.seed + r)
-        # the acceptance shares alpha among every candidate the round could name
-        confirmation = replace(settings.confirmation(), family=len(det.candidates),
-                               noise_floor=None if floor is None else floor.rms)
-        rnd.confirmed = confirm(now.fit, effects, now.priors, confirmation, scale,
-                                seed_offset=1000 * (r + 1), detection=det, screen=rnd.screen,
-                                top=settings.top)
+        if spent(settings):
+            unexplained = unexplained or det.significant
+            notes.append(cut_round(rnd, effects, r, settings))
+            break
+        best = sample_round(rnd, now, effects, analysis, settings, floor, r)
         notes += rough_notes(rnd, r)
-        best = rnd.accepted
         if best is None:
             unexplained = unexplained or det.significant
-            if det.significant:
-                notes.append(f"round {r + 1}: mismatch detected (p = {det.p_value:.3g}); "
-                             "no candidate sampled gained enough evidence")
+            notes += undecided_notes(rnd, r, settings)
             break
         now = Current(best.fit.structure, best.fit, best.fit.samples,
                       {**best.fit.priors, **now.priors})
@@ -115,16 +114,62 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
     return rounds, baseline_fit, unexplained, notes
 
 
+def sample_round(rnd: Round, now: Current, effects: list[str], analysis: Analysis,
+                 settings: DiagnosisSettings, floor, r: int) -> CandidateResult | None:
+    """The round's screen and confirmation of ``effects`` on the current structure; the
+    accepted candidate (None: none)."""
+    det = rnd.detection
+    begun = time.perf_counter()
+    scale = rnd.scale = motion_scale(rnd.state, analysis.window, det.frame.f_high)
+    rnd.screen = screen(now.fit, effects, now.priors, scale, det, settings.seed + r,
+                        stop=lambda: spent(settings))
+    rnd.unfinished += [Unfinished(f"round {r + 1}", now.fit.structure.with_term(e).name,
+                                  "not screened") for e in rnd.screen.unscreened]
+    rnd.seconds["screen"] = time.perf_counter() - begun
+    # the acceptance shares alpha among every candidate the round could name
+    confirmation = replace(settings.confirmation(), family=len(det.candidates),
+                           noise_floor=None if floor is None else floor.rms)
+    rnd.confirmed = confirm(now.fit, effects, now.priors, confirmation, scale,
+                            seed_offset=1000 * (r + 1), detection=det, screen=rnd.screen,
+                            top=settings.top, unfinished=rnd.unfinished,
+                            where=f"round {r + 1}")
+    rnd.seconds["confirm"] = time.perf_counter() - begun - rnd.seconds["screen"]
+    return rnd.accepted
+
+
+def cut_round(rnd: Round, effects: list[str], r: int, settings: DiagnosisSettings) -> str:
+    """Record a round the spent budget did not start (``rnd.unfinished``); its note."""
+    rnd.unfinished.append(Unfinished(f"round {r + 1}", ", ".join(effects),
+                                     "neither screened nor sampled"))
+    return f"round {r + 1}: not run, the time budget was spent"
+
+
+def undecided_notes(rnd: Round, r: int, settings: DiagnosisSettings) -> list[str]:
+    """Why a round named nothing: the budget ran out, or nothing gained enough evidence
+    where a mismatch was detected."""
+    det = rnd.detection
+    if rnd.unfinished:
+        return [f"round {r + 1}: not decided, the time budget ran out before its candidates "
+                "were sampled"]
+    if det.significant:
+        return [f"round {r + 1}: mismatch detected (p = {det.p_value:.3g}); no candidate "
+                "sampled gained enough evidence"]
+    return []
+
+
 def detect_round(analysis: Analysis, start: BaselineStart, now: Current,
                  settings: DiagnosisSettings, r: int) -> Round:
     """Detection, location and ranking of the current structure's mismatch."""
+    begun = time.perf_counter()
     problem = analysis.chain(start.detection_problem, start.temper, structure=now.structure)
     state = baseline_state(problem, now.samples)
     candidates = candidate_terms(now.structure.terms, settings.candidates)
     ds = settings.detection()
     det = detect(state, analysis.window, now.priors, candidates,
                  replace(ds, seed=ds.seed + r), time=analysis.time)
-    return Round(now.structure.name, det, state, rank(det, state, now.priors))
+    rnd = Round(now.structure.name, det, state, rank(det, state, now.priors))
+    rnd.seconds["detect"] = time.perf_counter() - begun
+    return rnd
 
 
 def rough_rivals(rnd: Round) -> list:

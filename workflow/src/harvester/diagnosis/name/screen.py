@@ -204,6 +204,7 @@ class Screen:
     #: the nested model's log evidence by importance sampling, the check of the estimator
     nested_importance: ImportanceEstimate | None = None
     importance_check: bool = False  # that estimate agrees with the nested model's sampled one
+    unscreened: list[str] = field(default_factory=list)  # not fitted: the time budget ran out
 
     @property
     def order(self) -> list[str]:
@@ -248,9 +249,11 @@ def fit_value(problem, theta: np.ndarray, priors: Mapping[str, PriorSpec],
 
 
 def screen(nested: ModelFit, effects: list[str], priors: Mapping[str, PriorSpec],
-           scale: DeviceScale, detection: Detection | None = None, seed: int = 0) -> Screen:
+           scale: DeviceScale, detection: Detection | None = None, seed: int = 0,
+           stop: Callable[[], bool] | None = None) -> Screen:
     """Each effect's MAP on the nested model's data and likelihood and its bounds, sorted by
-    ``bound`` (failed fits last)."""
+    ``bound`` (failed fits last). ``stop``: asked before each effect's fit; once it says so
+    (the time budget is spent) the effects left are not fitted (``Screen.unscreened``)."""
     nested_mean = nested.samples.mean(axis=0)
     point = fit_map(nested.problem, nested.priors, seed=seed, start=nested_mean[:-1])
     names = nested.names
@@ -260,7 +263,11 @@ def screen(nested: ModelFit, effects: list[str], priors: Mapping[str, PriorSpec]
                  nested_value=max(v for _, v in fits),
                  nested_laplace=point.log_evidence_laplace)
     check_estimator(out, nested, point, seed)
-    for effect in effects:
+    for i, effect in enumerate(effects):
+        if stop is not None and stop():
+            out.unscreened = list(effects[i:])
+            log.info("not screened, the time budget is spent: %s", ", ".join(out.unscreened))
+            break
         out.candidates.append(_screen_one(nested, effect, priors, scale, detection, seed,
                                           nested_mean, out))
     out.candidates.sort(key=lambda s: (s.failed, -s.bound))

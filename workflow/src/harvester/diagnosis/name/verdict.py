@@ -25,6 +25,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
 from harvester.data.units import SI, Units
+from harvester.diagnosis.name.budget import Unfinished
 from harvester.diagnosis.name.confirm import CandidateResult
 from harvester.diagnosis.name.fits import ModelFit
 from harvester.diagnosis.detect.scores import Detection
@@ -209,6 +210,8 @@ class Conclusion:
     #: candidates the evidence would accept whose implied device contradicts the sidecar
     #: (``plausibility``), each's sentence
     refused: list[str] = field(default_factory=list)
+    #: steps of the search the time budget cut (``budget``): neither named nor rejected
+    unfinished: list[Unfinished] = field(default_factory=list)
 
 
 def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings,
@@ -245,7 +248,8 @@ def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings
                       accepted[-1].fit if accepted else None, bool(accepted),
                       named_fit=named[-1] if named else None,
                       unsampled=[c.effect for rnd in rounds for c in rough_rivals(rnd)],
-                      tried=tried_effects(rounds), refused=refused)
+                      tried=tried_effects(rounds), refused=refused,
+                      unfinished=[u for rnd in rounds for u in rnd.unfinished])
 
 
 def tried_effects(rounds: list[Round]) -> set[str]:
@@ -507,9 +511,12 @@ def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
                      + ("fits better at its best fit but could not be sampled (its likelihood "
                         "jumps)" if one else "fit better at their best fits but could not be "
                         "sampled (their likelihoods jump)"))
+    if found.unfinished:
+        parts.append("the time budget ran out, these not decided: "
+                     + "; ".join(u.sentence() for u in found.unfinished))
     share = fit.library_share()
     if verdict != "adequate":
-        parts.append(_library_phrase(share, found.accepted))
+        parts.append(_library_phrase(share, found.accepted, bool(found.unfinished)))
         shaped = missing is not None and missing.shape_speaks
         if not found.accepted and not shaped and latent_unread(missing, fit, limit):
             parts.append("the missing force: not readable by the smoother (its noise took the "
@@ -519,10 +526,12 @@ def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
     return "; ".join(parts)
 
 
-def _library_phrase(share: float | None, accepted: bool) -> str:
-    """Whether the library explains the mismatch, part of it or none."""
+def _library_phrase(share: float | None, accepted: bool, cut: bool = False) -> str:
+    """Whether the library explains the mismatch, part of it or none (``cut``: the time
+    budget left candidates undecided)."""
     if not accepted:
-        return "the library explains none of the mismatch"
+        return ("no library effect decided within the time budget" if cut
+                else "the library explains none of the mismatch")
     if share is None:
         return "the library explains part of the mismatch (no unseen data to say how much)"
     if share >= 0.8:

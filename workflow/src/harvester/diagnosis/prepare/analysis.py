@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import arviz as az
 import numpy as np
@@ -317,8 +317,9 @@ def start_baseline(analysis: Analysis, priors: Mapping[str, PriorSpec] | None,
                  temper, 1.0 / temper)
         start = map_reference(mp, priors_for(a.fit_raw, specs)) if settings.reference_start \
             else None
+        # the baseline's own sampling: never cut by the budget (no deadline)
         fit = fit_structure(a.chain(a.fit_raw, temper), a.structure, specs,
-                            settings.confirmation(), reference=start)
+                            replace(settings.confirmation(), deadline=None), reference=start)
         return BaselineStart(fit, fit.samples, specs, temper, fit.log_evidence, "diagnosis",
                              a.chain(a.detection_raw, temper), a.chain(a.fit_raw, temper))
     samples = _posterior_samples(posterior, a.detection_raw.parameter_names)

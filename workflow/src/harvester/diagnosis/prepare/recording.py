@@ -12,6 +12,7 @@ and from Python.
 from __future__ import annotations
 
 import logging
+import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -56,6 +57,7 @@ class DiagnosisInput:
     source: str
     notes: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    started: float | None = None  # time.time() when its preparation began: the budget's start
 
 
 def diagnosis_input(recording: str | Path, baseline: str, *,
@@ -70,7 +72,7 @@ def diagnosis_input(recording: str | Path, baseline: str, *,
     ``lowpass_output_hz``: low-pass the output here (zero-phase, ``settings.filter_order``);
     ``defaults``: device parameters assumed where the sidecar lacks them (e.g. the paper's
     Table 1, ``defaults_from`` says so). DataError naming the file for bad input."""
-    source = str(recording)
+    source, started = str(recording), time.time()
     dev = read_device_recording(recording, defaults, defaults_from, accept=ACCEPT)
     checked, kp = dev.checked, dev.known
     if not input_kind(checked.kinds.input_kind).force_input and \
@@ -98,7 +100,7 @@ def diagnosis_input(recording: str | Path, baseline: str, *,
     for w in warnings:
         log.warning("%s", w)
     return DiagnosisInput(df, val, known, priors, settings, checked.sidecar, source,
-                          notes + form_notes + prior_notes, warnings)
+                          notes + form_notes + prior_notes, warnings, started)
 
 
 def _filtered(checked, validation: pd.DataFrame | None, settings: DiagnosisSettings,

@@ -54,6 +54,14 @@ class DiagnosisSettings:
     device_sd: the stated device's uncertainties, (name, sd) pairs (the sidecar's M_sd, m_sd,
     k_sd); device_relative_sd: that of a quantity without one, relative to its value; a
     candidate whose posterior implies a device beyond them is not named (``plausibility``).
+    budget, budget_s: the diagnosis's time budget (``name.budget``): a target in seconds of
+    wall time for the whole diagnosis (None: from the recording's length,
+    ``budget.budget_seconds``, 160 s for 10 s and 280 s for 40 s); the search for names gets
+    what the later steps leave of it, and past that no candidate's TMCMC goes on and no further
+    candidate, round or second pass starts; diagnosis.json says what was not finished. The
+    baseline's own sampling, the fit on unseen data, the missing force and the figures are not
+    cut. budget False: none (the study's setting: its results must not depend on the
+    machine's speed). deadline: set by ``diagnose`` (``time.time()``, s), never given.
     """
 
     particles: int = ConfirmSettings.particles
@@ -87,6 +95,9 @@ class DiagnosisSettings:
     units: Units = SI
     device_sd: tuple[tuple[str, float], ...] = ()
     device_relative_sd: float = DEFAULT_RELATIVE_SD
+    budget: bool = True
+    budget_s: float | None = None
+    deadline: float | None = None
 
     @classmethod
     def fast(cls, **overrides) -> "DiagnosisSettings":
@@ -101,6 +112,9 @@ class DiagnosisSettings:
         written to diagnosis.json as ``traded_away``); empty for the defaults."""
         default = DiagnosisSettings()
         lines = []
+        if self.budget and self.budget_s is not None:
+            lines.append(f"a time budget of {self.budget_s:g} s (default: from the "
+                         "recording's length)")
         if self.fit_seconds is not None:
             lines.append(f"TMCMC fits at most {self.fit_seconds:g} s of the analysed window "
                          "(default: all of it, as the detection)")
@@ -121,7 +135,7 @@ class DiagnosisSettings:
     @classmethod
     def from_config(cls, cfg: Mapping) -> "DiagnosisSettings":
         """From a config section (keys as the fields; ``fast: true`` starts from ``fast()``)."""
-        unknown = sorted(set(cfg) - set(cls.__dataclass_fields__) - {"fast"})
+        unknown = sorted(set(cfg) - set(cls.__dataclass_fields__) - {"fast", "deadline"})
         if unknown:
             raise ValueError(f"diagnosis settings: unknown key(s) {unknown}")
         values = {k: (tuple(v) if k == "candidates" and v is not None else v)
@@ -147,4 +161,5 @@ class DiagnosisSettings:
         return ConfirmSettings(particles=self.particles, chains=self.chains, seed=self.seed,
                                enlargements=self.enlargements, alpha=self.evidence_alpha,
                                reference=self.reference_start, device_sd=self.device_sd,
-                               device_relative_sd=self.device_relative_sd)
+                               device_relative_sd=self.device_relative_sd,
+                               deadline=self.deadline)

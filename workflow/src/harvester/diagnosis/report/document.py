@@ -164,7 +164,7 @@ def _finite(obj):
 #: The version of diagnosis.json's contract (``diagnosis.schema.json`` beside this module,
 #: docs/diagnosis-json.md): the major number changes when a key is removed or changes its
 #: meaning, the minor one when a key is added.
-SCHEMA_VERSION = "1.0"
+SCHEMA_VERSION = "1.1"
 #: The JSON Schema diagnosis.json validates against, shipped with the package.
 SCHEMA_PATH = Path(__file__).with_name("diagnosis.schema.json")
 
@@ -270,7 +270,8 @@ def _rounds(d) -> list[dict]:
                                       "trusted": rnd.screen.importance_check}),
              "accepted": rnd.accepted.effect if rnd.accepted else None,
              "named": bool(rnd.accepted and rnd.accepted.named),
-             "device_scale": asdict(rnd.scale) if rnd.scale is not None else None}
+             "device_scale": asdict(rnd.scale) if rnd.scale is not None else None,
+             "seconds": dict(rnd.seconds)}
             for rnd in d.rounds]
 
 
@@ -310,7 +311,8 @@ def _diagnosis_dict(d) -> dict:
         "traded_away": d.settings.trades(),
         "priors": {k: prior_dict(v) for k, v in d.priors.items()},
         "settings": {k: (list(v) if isinstance(v, tuple) else v)
-                     for k, v in s.__dict__.items()},
+                     for k, v in s.__dict__.items() if k != "deadline"},
+        "budget": d.budget,
         "runtime_s": d.seconds,
         "notes": d.notes,
         "figures": list(getattr(d, "figure_files", [])),
