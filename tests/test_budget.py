@@ -91,6 +91,8 @@ def test_a_spent_budget_leaves_the_round_undecided(record, tmp_path):
     assert "time budget ran out" in diag.headline, diag.headline
     assert "no library effect decided within the time budget" in diag.headline
     assert "deadline" not in doc["settings"]
+    page = (tmp_path / "summary.html").read_text()
+    assert "Not decided within the budget" in page and "coulomb_friction" in page
     steps = [t["step"] for t in doc["budget"]["timeline"]]
     assert steps[:4] == ["input", "prepare", "baseline", "rounds"] and "missing force" in steps
 

@@ -166,9 +166,27 @@ def summary_page(doc: Mapping[str, Any], figure_dir: str | Path, title: str) -> 
               if Path(f).name not in listed and (figure_dir / Path(f).name).is_file()]
     if others:
         body.append("<h2>Other figures</h2>" + "".join(others))
+    body.append(_time_section(doc.get("budget") or {}, doc.get("runtime_s")))
     body.append(_notes(doc.get("notes") or []))
     return (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{_esc(title)}</title>"
             f"<style>{STYLE}</style></head><body>{''.join(body)}</body></html>\n")
+
+
+def _time_section(budget: Mapping[str, Any], runtime: float | None) -> str:
+    """The time budget, what it left undecided, and where the time went (``budget``)."""
+    total = budget.get("seconds")
+    head = (f"<p>{_num(runtime)} s; no time budget</p>" if total is None else
+            f"<p>{_num(runtime)} s of a budget of {total:.0f} s (the search's share "
+            f"{budget.get('search_budget_seconds') or 0:.0f} s)</p>")
+    cut = [f"<li>{_esc(u['where'])}: {_esc(u['what'])}: {_esc(u['how'])}</li>"
+           for u in budget.get("unfinished") or []]
+    undecided = ("<p>Not decided within the budget (run again with a larger "
+                 "<code>--budget</code> to decide them):</p><ul>" + "".join(cut) + "</ul>"
+                 if cut else "")
+    rows = "".join(f"<tr><td>{_esc(t['step'])}</td><td>{t['seconds']:.1f}</td></tr>"
+                   for t in budget.get("timeline") or [])
+    table = f"<table><tr><th>step</th><th>s</th></tr>{rows}</table>" if rows else ""
+    return "<h2>Time</h2>" + head + undecided + table
 
 
 def _notes(notes: Sequence[str]) -> str:
