@@ -4,6 +4,7 @@ seconds per record (``harvester.grid.peers``).
 
     python benchmarks/bench_peers.py --set DIR [--skip-diagnosis] [--no-narx] [--csv OUT]
     python benchmarks/bench_peers.py --make DIR [--effects duffing ...] [--free-seeds 0 1]
+    python benchmarks/bench_peers.py --make DIR --real [--fast] [--jobs 2] --set DIR
 
 ``--set DIR``: any folder of acceleration recordings (``<name>.csv`` with its sidecar
 ``<name>.yaml``) each with a truth ``<name>.json`` (``correct_names``, ``ratio``; as the
@@ -17,14 +18,25 @@ thresholds, SysIdentPy's polynomial NARX free run. pysindy and sysidentpy: ``pip
 
 ``--make DIR``: writes literature-grid records into DIR as the grid makes them
 (config/config.yaml: 40 s at 256 Hz, ratio 0.5, the grid's seed offset): each of
-``--effects`` at seed 0 and the effect-free record at each of ``--free-seeds``.
+``--effects`` at seed 0 and the effect-free record at each of ``--free-seeds``
+(``--effects`` with no name: none). ``--real``: the shipped real recordings too (the frame at
+250 g and 450 g, the Silverbox; ``grid.recorded``: their truths and why), read from
+``--data`` (default data/public); their diagnosis is ``diagnosis.diagnose_recording``, the
+command line's call on the file, against the study's linear baseline.
+
+``--fast``: the diagnosis's ``DiagnosisSettings.fast`` (15 s fitted by TMCMC, one round, two
+candidates sampled; the grid's fast settings) on every record. ``--jobs N``: N diagnoses at
+once, each integrating on cores / N threads. The command's wall time is printed last.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import pandas as pd
@@ -33,6 +45,7 @@ import yaml
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = ROOT / "config" / "config.yaml"
 EFFECTS = ("duffing", "quadratic_damping", "stribeck_exponential", "end_stop_hertz")
+DATA = ROOT / "data" / "public"
 
 
 def make_set(out: Path, effects, free_seeds) -> None:
@@ -56,21 +69,64 @@ def make_set(out: Path, effects, free_seeds) -> None:
         print(f"made {csv.name}", flush=True)
 
 
-def run_diagnosis_cached(rec) -> dict:
-    """The record's diagnosis (``grid.scoring.run_diagnosis``), kept beside it."""
-    from harvester.data.sidecar import read_sidecar
-    from harvester.grid.scoring import run_diagnosis
+def run_diagnosis_cached(rec, fast: bool = False) -> dict:
+    """The record's diagnosis, kept beside it (``<name>.diagnosis.json``): a real
+    recording's (truth ``diagnose: recording``) by ``diagnosis.diagnose_recording``, the
+    command's call on the file; a grid record's by ``grid.scoring.run_diagnosis``, the
+    grid's. ``fast``: ``DiagnosisSettings.fast`` with 15 s fitted (the grid's)."""
     kept = rec.path.with_suffix(".diagnosis.json")
     if kept.is_file():
         return json.loads(kept.read_text())
+    d = _recorded_diagnosis(rec, fast) if rec.truth.get("diagnose") == "recording" \
+        else _grid_diagnosis(rec, fast)
+    kept.write_text(json.dumps(d, default=str))
+    return d
+
+
+def _grid_diagnosis(rec, fast: bool) -> dict:
+    from harvester.data.sidecar import read_sidecar
+    from harvester.grid.scoring import run_diagnosis
     t = rec.data["time"].to_numpy()
     fs = 1.0 / float(t[1] - t[0])
     lead_in = float((rec.truth.get("settings") or {}).get("lead_in_s", 1.0))
-    d = run_diagnosis(rec.data, rec.truth.get("baseline", "tanh"), rec.known, seed=0,
-                      lead_in=int(round(lead_in * fs)),
-                      lowpass_hz=read_sidecar(rec.path).filtered_at_hz)
-    kept.write_text(json.dumps(d, default=str))
+    return run_diagnosis(rec.data, rec.baseline, rec.known, seed=0, fast=fast,
+                         lead_in=int(round(lead_in * fs)),
+                         lowpass_hz=read_sidecar(rec.path).filtered_at_hz)
+
+
+def _recorded_diagnosis(rec, fast: bool) -> dict:
+    from harvester.diagnosis import DiagnosisSettings, diagnose_recording
+    clock = time.perf_counter()
+    settings = DiagnosisSettings.fast(fit_seconds=15.0, figures=False) if fast \
+        else DiagnosisSettings(figures=False)
+    d = diagnose_recording(rec.path, rec.baseline, settings=settings).to_dict()
+    d["runtime_s"] = time.perf_counter() - clock
+    d["implementation"] = "harvester.diagnosis.diagnose_recording" + (" (fast)" if fast else "")
     return d
+
+
+def _diagnose_path(csv: str, fast: bool, threads: int) -> str:
+    """A worker's job: the diagnosis of the record ``csv`` of its set, kept beside it."""
+    from harvester.grid.peers import read_set
+    from harvester.runlog import use_threads
+    use_threads(threads)
+    (rec,) = [r for r in read_set(Path(csv).parent) if str(r.path) == csv]
+    run_diagnosis_cached(rec, fast)
+    return csv
+
+
+def diagnose_all(records, fast: bool, jobs: int) -> None:
+    """The diagnoses not kept yet, ``jobs`` at once (each on cores / jobs threads)."""
+    todo = [str(r.path) for r in records if not r.path.with_suffix(".diagnosis.json").is_file()]
+    if jobs <= 1 or len(todo) <= 1:
+        for csv in todo:
+            _diagnose_path(csv, fast, os.cpu_count() or 1)
+            print(f"diagnosed {Path(csv).stem}", flush=True)
+        return
+    threads = max(1, (os.cpu_count() or 1) // jobs)
+    with ProcessPoolExecutor(jobs) as pool:
+        for csv in pool.map(_diagnose_path, todo, [fast] * len(todo), [threads] * len(todo)):
+            print(f"diagnosed {Path(csv).stem}", flush=True)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -83,18 +139,32 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--kept-only", action="store_true",
                    help="the diagnosis only where a <name>.diagnosis.json is kept (none run)")
     p.add_argument("--no-narx", action="store_true", help="without the NARX free run")
+    p.add_argument("--real", action="store_true",
+                   help="with --make: the shipped real recordings too (grid.recorded)")
+    p.add_argument("--data", type=Path, default=DATA, help="folder of the real recordings")
+    p.add_argument("--fast", action="store_true", help="the diagnosis's fast settings")
+    p.add_argument("--jobs", type=int, default=1, help="diagnoses run at once")
     p.add_argument("--csv", type=Path, help="write the per-record rows here")
     args = p.parse_args(argv)
+    clock = time.perf_counter()
     if args.make:
         make_set(args.make, args.effects, args.free_seeds)
+        if args.real:
+            from harvester.grid.recorded import write_recorded_set
+            for csv in write_recorded_set(args.data, args.make):
+                print(f"made {csv.name}", flush=True)
     if not args.set:
         return 0
     from harvester.grid.peers import diagnosis_row, peer_rows, read_set, summary
+    records = read_set(args.set)
+    if not (args.skip_diagnosis or args.kept_only):
+        diagnose_all(records, args.fast, args.jobs)
     rows = []
-    for rec in read_set(args.set):
+    for rec in records:
         kept = rec.path.with_suffix(".diagnosis.json").is_file()
         run = not args.skip_diagnosis and (kept or not args.kept_only)
-        found = [diagnosis_row(rec, run_diagnosis_cached)] if run else []
+        found = [diagnosis_row(rec, lambda r: run_diagnosis_cached(r, args.fast))] if run \
+            else []
         for r in found + peer_rows(rec, narx=not args.no_narx):
             rows.append({"record": rec.path.stem, "correct": " ".join(sorted(rec.correct)),
                          **r, "names": " ".join(r["names"])})
@@ -106,6 +176,8 @@ def main(argv: list[str] | None = None) -> int:
         table.to_csv(args.csv, index=False)
     print()
     print(summary(table).to_string(index=False, float_format=lambda x: f"{x:.3g}"))
+    print(f"\n{len(records)} records, wall time {time.perf_counter() - clock:.0f} s "
+          f"({'fast' if args.fast else 'default'} diagnosis settings, {args.jobs} at once)")
     return 0
 
 

@@ -238,6 +238,15 @@ def diagnosis_file(group, model, name="diagnosis.json"):
     return f"results/groups/{group}/diagnosis/{model}/{name}"
 
 
+def group_links(group):
+    """Pages a group's diagnosis summary links to (text, href from the summary): a benchmark
+    group's benchmark tests beside the published results (rule silverbox_benchmark)."""
+    if group not in BENCHMARK_GROUPS:
+        return []
+    return [("The benchmark's own tests: this group's models beside the published results "
+             "(benchmark.html)", "../../benchmark.html")]
+
+
 def diagnosis_inputs(group, model):
     """A diagnosis's recording, its posterior and priors, and the group's first validation
     recording (none: the diagnosis holds out the recording's last quarter)."""

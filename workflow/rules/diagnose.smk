@@ -16,6 +16,7 @@ rule diagnose:
         group=one_of([g for g in GENERIC_GROUPS if DIAGNOSED[g]]),
     params:
         settings=lambda w: group_params(w.group, "diagnosis"),
+        links=lambda w: group_links(w.group),
     threads: JOB_THREADS
     resources:
         mem_mb=4000,

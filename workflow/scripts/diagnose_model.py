@@ -16,5 +16,5 @@ with rule_log(snakemake) as log:  # noqa: F821
     with atomic_path(sm.output.summary) as tmp:
         tmp.write_text(summary_page(read_json(sm.output.json), Path(sm.output.json).parent,
                                     f"Diagnosis of {sm.wildcards.model}, group "
-                                    f"{sm.wildcards.group}"))
+                                    f"{sm.wildcards.group}", sm.params.links))
     log.info("verdict %s, missing %s", diag.verdict, diag.missing)

@@ -137,10 +137,12 @@ def _num(x: Any) -> str:
     return "-" if x is None else f"{x:.3g}"
 
 
-def summary_page(doc: Mapping[str, Any], figure_dir: str | Path, title: str) -> str:
+def summary_page(doc: Mapping[str, Any], figure_dir: str | Path, title: str,
+                 links: Sequence[tuple[str, str]] = ()) -> str:
     """The page (module docstring) of diagnosis.json ``doc`` with the figures in
     ``figure_dir``; figures of ``doc["figures"]`` outside :data:`SECTIONS` go last, with
-    their line from ``doc["figure_captions"]`` where it gives one."""
+    their line from ``doc["figure_captions"]`` where it gives one; ``links`` (text, href
+    relative to the page) last, under "See also" (a group's benchmark page)."""
     figure_dir = Path(figure_dir)
     body = [f"<h1>{_esc(title)}</h1>",
             f'<p class="headline">{_esc(doc.get("headline") or doc.get("verdict"))}</p>',
@@ -168,6 +170,10 @@ def summary_page(doc: Mapping[str, Any], figure_dir: str | Path, title: str) -> 
         body.append("<h2>Other figures</h2>" + "".join(others))
     body.append(_time_section(doc.get("budget") or {}, doc.get("runtime_s")))
     body.append(_notes(doc.get("notes") or []))
+    if links:
+        body.append("<h2>See also</h2><ul>" + "".join(
+            f'<li><a href="{_esc(href)}">{_esc(text)}</a></li>' for text, href in links)
+            + "</ul>")
     return (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{_esc(title)}</title>"
             f"<style>{STYLE}</style></head><body>{''.join(body)}</body></html>\n")
 
