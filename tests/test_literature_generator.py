@@ -18,7 +18,8 @@ from scipy.integrate import solve_ivp
 
 LIBRARY_TERMS = {"coulomb_friction", "tanh_friction", "stribeck_friction", "asymmetric_friction",
                  "quadratic_damping", "cubic_stiffness", "end_stop", "backlash", "hysteresis",
-                 "unmodelled_mode", "inertia_error", "offset_force"}
+                 "unmodelled_mode", "inertia_error", "offset_force", "sticking_friction",
+                 "sticking_stribeck"}
 NOISE = 0.09
 FS = 256.0
 
@@ -52,7 +53,7 @@ def test_registry_names_families_and_citations():
         assert not set(scen.correct_names) & set(scen.related_names)
         families.setdefault(scen.family, []).append(name)
     counts = {f: len(v) for f, v in families.items()}
-    assert counts["pre-sliding friction with memory"] == 3
+    assert counts["pre-sliding friction with memory"] == 4
     assert counts["stiction/breakaway"] == 3
     assert counts["end stop contact"] == 3
     assert counts["hardening spring"] == 2
@@ -84,6 +85,31 @@ def test_every_effect_at_zero_strength_is_the_baseline():
         out = _output(run, tb, kind, p)
         # equal up to the finer sub-steps taken near a stop or the stick band
         assert np.max(np.abs(out - base)) < 1e-7, name
+
+
+def test_maxwell_slip_elements_hold_then_slip_at_their_levels():
+    """Iwan's elements on a prescribed z: inside D_1 a spring (no loop), far beyond D_2 the
+    whole level s F_c, never more; the loop's width at z = 0 is the elements' level."""
+    p = np.zeros(L.E + 4)
+    p[L._FC] = 2.0
+    p[L.E:L.E + 4] = [0.5, 0.4, 1e-6, 5e-6]  # s, a, D_1, D_2: levels 0.4 and 0.6 N
+
+    def forces(amplitude):
+        x = np.zeros(5)
+        out = []
+        for z in amplitude * np.sin(np.linspace(0.0, 4 * np.pi, 4001)):
+            x[0] = z
+            L._play(p, x)
+            out.append(L._slip_force(p, z, x[2], x[3]))
+        return np.array(out)
+    small = forces(0.5e-6)
+    stiffness = 0.4 / 1e-6 + 0.6 / 5e-6
+    z = 0.5e-6 * np.sin(np.linspace(0.0, 4 * np.pi, 4001))
+    assert np.allclose(small, stiffness * z, rtol=1e-12, atol=1e-15)  # elastic, no loop
+    large = forces(1e-4)
+    assert np.max(np.abs(large)) == pytest.approx(1.0, rel=1e-12)  # s F_c, never more
+    crossing = large[np.argmin(np.abs(z[2000:] / 0.5e-6 * 1e-4)) + 2000]
+    assert abs(crossing) == pytest.approx(1.0, rel=1e-3)  # both elements slipping at z = 0
 
 
 def test_mode_and_mount_vanish_with_their_strength():
@@ -385,8 +411,11 @@ def test_forms_outside_the_library_have_no_correct_name_and_a_citation():
     for name in OUTSIDE:
         scen = L.SCENARIOS[name]
         assert scen.correct_names == () and scen.citation and scen.shapes, name
-    # appended after the effect-free scenario: the grid's earlier scenarios keep their places
-    assert list(L.SCENARIOS)[-len(OUTSIDE) - 1:] == ["none", *OUTSIDE]
+    # appended after the effect-free scenario, and Maxwell-slip after them: the grid's earlier
+    # scenarios keep their places
+    names = list(L.SCENARIOS)
+    at = names.index("none")
+    assert names[at:at + len(OUTSIDE) + 2] == ["none", *OUTSIDE, "maxwell_slip"]
 
 
 def _shape_and_effect(name, strength, seed=0):

@@ -22,7 +22,7 @@ scenario                form (citation in the registry)             correct (rel
 lugre                   (1-s) F_dev + s LuGre, sigma0 1e3-1e6 N/m   hysteresis (coulomb)
 dahl                    (1-s) F_dev + s Dahl, alpha 0.5-2           hysteresis (coulomb)
 bouc_wen                (1-s) F_dev + s F_c w, Bouc-Wen n 1-3       hysteresis (coulomb)
-karnopp                 (1-s) F_dev + s Karnopp, F_s/F_c 1.2-2      stribeck, coulomb
+karnopp                 (1-s) F_dev + s Karnopp, F_s/F_c 1.2-2      stribeck, coulomb, sticking
 stribeck_exponential    F_dev (1 + s exp(-|v|/v_s))                 stribeck (coulomb)
 stribeck_gaussian       F_dev (1 + s exp(-(v/v_s)^2))               stribeck (coulomb)
 asymmetric_friction     F_dev (1 + s tanh(v/v_a))                   asymmetric (offset_force)
@@ -42,19 +42,24 @@ cogging                 A sin(2 pi z / P + phi), P 0.67-2 z_rms     -- (none)
 quadratic_spring        k2 z^2 (a spring stiffer on one side)       -- (offset_force)
 friction_drift          F_dev (1 + s (t - T/2) / T), T the record   -- (none)
 mains_hum               rel_acc + A sin(2 pi 50|60 Hz t + phi)      -- (unmodelled_mode)
+maxwell_slip            (1-s) F_dev + s 2 Maxwell-slip elements     hysteresis, sticking (coulomb)
 ======================  ==========================================  =========================
 
-The last four are outside the library (no correct name): a force periodic in the
+The four after the effect-free one are outside the library (no correct name): a force periodic in the
 displacement (a generator's cogging through the screw), an even spring, a slow change (the
 friction's level drifting; a slow force itself would not show in z'', whose response to it
 falls as (f / f_n)^2), and the acquisition's own line (mains hum on the mass accelerometer's
-channel, added to the reading before the DAQ's filter, not to the motion).
+channel, added to the reading before the DAQ's filter, not to the motion). Maxwell-slip, a
+friction law with memory, was added after them, so that the earlier scenarios keep their
+places in the grids.
 
 Naming: ``correct_names`` are the library terms that name the mechanism; ``related_names``
 describe part of its signature but another physical cause, and are not counted. A memory law's
 sliding limit is Coulomb-sharp, so ``coulomb_friction`` explains part of it, not its memory.
-Karnopp's element is Coulomb sliding plus breakaway: both ``stribeck_friction`` and
-``coulomb_friction`` name it. Direction-dependent friction equals symmetric friction plus a
+Karnopp's element is Coulomb sliding plus breakaway and a true stick: ``stribeck_friction``,
+``coulomb_friction`` and their sticking forms name it. Maxwell-slip's elements hold
+elastically (pre-sliding) and slip at their levels: ``hysteresis`` and ``sticking_friction``
+name it. Direction-dependent friction equals symmetric friction plus a
 constant force while sliding, but exerts nothing at rest, so ``offset_force`` (a preload or
 gravity, which does) is related only. Stops are local (a gap) and a cubic spring global: each
 is the other's related name. Below a secondary mode the whole mass moves and above it part of
@@ -140,7 +145,7 @@ N_PARAMS = E + 8
 # Effect kinds of the compiled right-hand side.
 (NONE, LUGRE, DAHL, BOUC_WEN, KARNOPP, STRIBECK, ASYMMETRIC, STOP_KV, STOP_POWER,
  SPRING_POWER, DAMP_POWER, MOUNT, SECONDARY, PERIODIC_Z, SPRING_EVEN, FRICTION_DRIFT,
- SENSOR_LINE) = range(17)
+ SENSOR_LINE, MAXWELL_SLIP) = range(18)
 
 
 # --------------------------------------------------------------------------- compiled physics
@@ -187,6 +192,25 @@ def _friction(kind, p, v, w, rest):
     if kind == STRIBECK:
         return f * (1.0 + s * np.exp(-(abs(v) / p[E + 1]) ** p[E + 2]))
     return f * (1.0 + s * np.tanh(v / p[E + 1]))  # ASYMMETRIC
+
+
+@nb.njit(cache=True)
+def _slip_force(p, z, w1, w2):
+    """Maxwell-slip (Iwan 1966; Al-Bender, Lampaert and Swevers 2005): two elasto-slip
+    elements, element i's spring k_i = W_i / D_i from its slider at w_i, its force held within
+    +-W_i (the slider moves when it would exceed it, :func:`_play`): W_1 = a s F_c,
+    W_2 = (1 - a) s F_c, each W_i (z - w_i) / D_i clipped to +-W_i (N)."""
+    w_total = p[E] * p[_FC]
+    f1 = p[E + 1] * w_total * min(max((z - w1) / p[E + 2], -1.0), 1.0)
+    f2 = (1.0 - p[E + 1]) * w_total * min(max((z - w2) / p[E + 3], -1.0), 1.0)
+    return f1 + f2
+
+
+@nb.njit(cache=True)
+def _play(p, x):
+    """The sliders of :func:`_slip_force` after a step: each within D_i of z (exact)."""
+    for j, d in ((2, p[E + 2]), (3, p[E + 3])):
+        x[j] = min(max(x[j], x[0] - d), x[0] + d)
 
 
 @nb.njit(cache=True)
@@ -259,6 +283,8 @@ def _rhs(kind, p, x, yb, dx):
     rest = -p[_MOSC] * yb - p[_C] * v - p[_K] * z - _extra_force(kind, p, z, v, x[4])
     if kind == FRICTION_DRIFT:  # x[4] holds the time (s)
         acc = (rest - _kinetic(p, v) * (1.0 + p[E] * (x[4] - p[E + 1]) / p[E + 2])) / p[_M]
+    elif kind == MAXWELL_SLIP:  # sliders x[2], x[3], moved by _play
+        acc = (rest - (1.0 - p[E]) * _kinetic(p, v) - _slip_force(p, z, x[2], x[3])) / p[_M]
     else:
         acc = (rest - _friction(kind, p, v, x[2], rest)) / p[_M]
     dx[0], dx[1] = v, acc
@@ -335,6 +361,8 @@ def _substep(kind, p, x, y0, ym, y1, h, work):
         x[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
     if memory:
         _relax(kind, p, x, 0.5 * h)
+    if kind == MAXWELL_SLIP:
+        _play(p, x)
     if kind == STOP_POWER:
         _note_impact(p, x, z0, v0)
 
@@ -790,6 +818,11 @@ _CITE = {
     "bouc_wen": "Bouc, R. (1967) Forced vibration of mechanical systems with hysteresis. Proc. "
                 "4th Conf. Nonlinear Oscillations, Prague; Wen, Y.-K. (1976) Method for random "
                 "vibration of hysteretic systems. J. Eng. Mech. Div. ASCE 102(2):249-263.",
+    "maxwell_slip": "Iwan, W.D. (1966) A distributed-element model for hysteresis and its "
+                    "steady-state dynamic response. J. Appl. Mech. 33(4):893-900; Al-Bender, "
+                    "F., Lampaert, V., Swevers, J. (2005) The generalized Maxwell-slip model: "
+                    "a novel model for friction simulation and compensation. IEEE Trans. "
+                    "Autom. Control 50(11):1883-1887.",
     "karnopp": "Karnopp, D. (1985) Computer simulation of stick-slip friction in mechanical "
                "dynamic systems. ASME J. Dyn. Syst. Meas. Control 107(1):100-103.",
     "stribeck": "Armstrong-Helouvry, B., Dupont, P., Canudas de Wit, C. (1994) A survey of "
@@ -872,6 +905,30 @@ def _memory(name: str, kind: int, form: str, shapes: str, extra: Callable) -> Li
         f"0.2 z_rms)); {shapes}", draw, lambda ctx, sh: _SHARE, effect)
 
 
+def _maxwell_slip() -> LiteratureScenario:
+    """Two Maxwell-slip elements carrying a share s of the contact (appended after the forms
+    outside the library, so that the grid's earlier scenarios keep their places)."""
+    def draw(rng: np.random.Generator, ctx: Context) -> dict:
+        return {"stiffness": _bristle_stiffness(rng, ctx), "first": rng.uniform(0.3, 0.7),
+                "spread": _log_uniform(rng, 3.0, 10.0)}
+
+    def effect(ctx: Context, sh: dict, s: float) -> Effect:
+        d1 = ctx.device.F_c / sh["stiffness"]
+        return MAXWELL_SLIP, [s, sh["first"], d1, sh["spread"] * d1], {}
+
+    return LiteratureScenario(
+        "maxwell_slip", "pre-sliding friction with memory",
+        "F = (1 - s) F_c S(v/v_t) + sum_i clip(W_i (z - w_i) / D_i, +-W_i), slider w_i kept "
+        "within D_i of z; W_1 = a s F_c, W_2 = (1 - a) s F_c",
+        ("hysteresis", "sticking_friction"), ("coulomb_friction",),
+        "two Maxwell-slip (elasto-slip) elements carry a share s of the contact: each sticks "
+        "elastically until its spring holds W_i, then slips",
+        _CITE["maxwell_slip"], "share s of the contact, 1e-5..1",
+        "D_1 = F_c / k with k 1e3-1e6 N/m log-uniform (1 um..min(1 mm, 0.2 z_rms)), D_2 = r D_1 "
+        "with r 3-10 log-uniform, first element's share a 0.3-0.7",
+        draw, lambda ctx, sh: _SHARE, effect)
+
+
 def _friction_scenarios() -> list[LiteratureScenario]:
     S, rel = LiteratureScenario, _relative
     entries = [
@@ -884,7 +941,8 @@ def _friction_scenarios() -> list[LiteratureScenario]:
                 "v |w|^n, z_y = F_c / k_b, gamma = 1 - beta", "n 1-3, beta 0.5-1",
                 lambda rng: {"n": rng.uniform(1.0, 3.0), "beta": rng.uniform(0.5, 1.0)}),
         S("karnopp", "stiction/breakaway", "F = (1 - s) F_c S(v/v_t) + F_K; F_K = clip(F_rest, "
-          "+-s r F_c) if |v| < dv else s F_c sgn v", ("stribeck_friction", "coulomb_friction"),
+          "+-s r F_c) if |v| < dv else s F_c sgn v",
+          ("stribeck_friction", "coulomb_friction", "sticking_stribeck", "sticking_friction"),
           (), "Karnopp stick-slip element (breakaway r F_c) carries a share s of the contact",
           _CITE["karnopp"], "share s, 1e-5..1",
           "breakaway ratio r 1.2-2; stick band dv 10^(-1.5..-0.5) v_rms",
@@ -1082,7 +1140,8 @@ def _scenarios() -> dict[str, LiteratureScenario]:
         "no concealed effect (false-alarm check)", _CITE["none"], "none", "none",
         lambda rng, ctx: {}, lambda ctx, sh: (0.0, 0.0), lambda ctx, sh, s: (NONE, [], {}))
     entries = (_friction_scenarios() + _stop_scenarios() + _spring_scenarios()
-               + _structural_and_mass() + _damping() + [none] + _outside_library())
+               + _structural_and_mass() + _damping() + [none] + _outside_library()
+               + [_maxwell_slip()])
     return {e.name: e for e in entries}
 
 
@@ -1095,7 +1154,7 @@ SCENARIOS: dict[str, LiteratureScenario] = _scenarios()
 _KIND_NAMES = ("none", "lugre", "dahl", "bouc_wen", "karnopp", "stribeck", "asymmetric",
                "stop_kelvin_voigt", "stop_power", "spring_power", "damper_power", "mount",
                "secondary_mode", "periodic_in_z", "spring_even", "friction_drift",
-               "sensor_line")
+               "sensor_line", "maxwell_slip")
 #: Names of the effect parameters p[E:] per kind (SI units).
 EFFECT_PARAMETERS: dict[int, tuple[str, ...]] = {
     NONE: (), LUGRE: ("share", "sigma0_N_per_m", "sigma1_N_s_per_m"),
@@ -1112,6 +1171,7 @@ EFFECT_PARAMETERS: dict[int, tuple[str, ...]] = {
     PERIODIC_Z: ("amplitude_N", "period_m", "phase_rad"), SPRING_EVEN: ("k2_N_per_m2",),
     FRICTION_DRIFT: ("change_over_record", "t_centre_s", "record_s"),
     SENSOR_LINE: ("amplitude_m_per_s2", "frequency_hz", "phase_rad"),
+    MAXWELL_SLIP: ("share", "first_element_share", "D1_m", "D2_m"),
 }
 
 
