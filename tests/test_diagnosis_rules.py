@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from harvester.diagnosis.detect.scores import DetectionSettings, data_estimate, prior_conflicts
-from harvester.diagnosis.name.rank import RankedCandidate, rivals, to_confirm
+from harvester.diagnosis.name.rank import RankedCandidate, limit_rivals, rivals, to_confirm
 from harvester.inference.priors import PriorSpec
 from harvester.diagnosis.detect.floor import Floor
 from harvester.diagnosis.run import decide_verdict
@@ -88,6 +88,18 @@ def test_an_open_round_fits_every_rival_whose_score_points_towards_it():
     assert [r.effect for r in chosen] == ["unmodelled_mode", "inertia_error"]
     assert [r.effect for r in rivals(ranked, chosen)] == ["cubic_stiffness", "end_stop"]
     assert rivals(ranked, ranked) == []
+
+
+def test_a_terms_limits_are_screened_beside_it():
+    """Hysteresis with no pre-sliding displacement is friction that sticks, or a sign law:
+    both are screened where hysteresis is, if the structure can take them and they are not
+    screened already; a term without limits brings none."""
+    allowed = set(candidate_terms(()))
+    assert limit_rivals(["hysteresis", "cubic_stiffness"], allowed) == [
+        "sticking_friction", "coulomb_friction"]
+    assert limit_rivals(["hysteresis", "coulomb_friction"], allowed) == ["sticking_friction"]
+    assert limit_rivals(["cubic_stiffness"], allowed) == []
+    assert limit_rivals(["hysteresis"], allowed - {"sticking_friction"}) == ["coulomb_friction"]
 
 
 def test_candidates_similar_to_a_chosen_one_are_sampled_too():

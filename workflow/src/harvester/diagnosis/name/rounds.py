@@ -25,7 +25,8 @@ from harvester.diagnosis.name.confirm import CandidateResult, confirm, fit_struc
 from harvester.diagnosis.name.fits import ModelFit
 from harvester.diagnosis.detect.floor import problem_floor
 from harvester.diagnosis.detect.scores import Detection, detect
-from harvester.diagnosis.name.rank import RankedCandidate, rank, rivals, to_confirm
+from harvester.diagnosis.name.rank import (RankedCandidate, limit_rivals, rank, rivals,
+                                           to_confirm)
 from harvester.diagnosis.name.screen import Screen, screen
 from harvester.diagnosis.prepare.settings import DiagnosisSettings
 from harvester.diagnosis.detect.signatures import candidate_terms, motion_scale
@@ -98,6 +99,8 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
             baseline_fit = baseline_fit or now.fit
         effects = [c.effect for c in chosen + rivals(rnd.ranked, chosen)]
         effects += [e for e in extra if e not in effects]
+        effects += limit_rivals(effects, set(candidate_terms(now.structure.terms,
+                                                             settings.candidates)))
         if spent(settings):
             unexplained = unexplained or det.significant
             notes.append(cut_round(rnd, effects, r, settings))
