@@ -445,13 +445,11 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
         reason = skip_reason(screened, results, settings, top, baseline.log_evidence_se,
                              single, estimate=not late)
         if reason is None and late:
-            reason = "the time budget ran out before it"
+            reason = BUDGET_REASON
         if reason is not None:
-            _skipped(screened, effect, reason)
-            if effect in pulled:
-                edges = {n: side for n, (side, _) in screened.pulled.items()}
-                order[i + 1:i + 1] = limit_candidates(effect, edges, baseline.structure, order)
-            if reason.startswith("the time budget"):
+            order[i + 1:i + 1] = _skip(screened, effect, reason, effect in pulled,
+                                       baseline.structure, order)
+            if late and reason == BUDGET_REASON:
                 cut.append(Unfinished(where, baseline.structure.with_term(effect).name,
                                       "not sampled"))
             continue
@@ -478,6 +476,21 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
     results.sort(key=lambda r: -r.delta_log_evidence)
     mark_ties(results, settings)
     return results
+
+
+#: Why a candidate the time budget left was not sampled.
+BUDGET_REASON = "the time budget ran out before it"
+
+
+def _skip(screened, effect: str, reason: str, pulled: bool, structure: ModelStructure,
+          order: list[str]) -> list[str]:
+    """Say why ``effect`` is not sampled; the terms it stands for at the bound its best fit
+    lies on (where it is ``pulled``), to sample next in its place."""
+    _skipped(screened, effect, reason)
+    if not pulled:
+        return []
+    edges = {n: side for n, (side, _) in screened.pulled.items()}
+    return limit_candidates(effect, edges, structure, order)
 
 
 def _skipped(screened, effect: str, reason: str) -> None:
