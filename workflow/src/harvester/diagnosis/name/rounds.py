@@ -24,6 +24,7 @@ from harvester.diagnosis.detect.floor import problem_floor
 from harvester.diagnosis.detect.scores import Detection, detect
 from harvester.diagnosis.name.rank import RankedCandidate, rank, rivals, to_confirm
 from harvester.diagnosis.name.screen import Screen, screen
+from harvester.diagnosis.name.simulable import withdraw_divergent
 from harvester.diagnosis.prepare.settings import DiagnosisSettings
 from harvester.diagnosis.detect.signatures import candidate_terms, motion_scale
 from harvester.model.priors import DeviceScale
@@ -74,6 +75,8 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
     for r in range(settings.rounds + 1):
         rnd = detect_round(analysis, start, now, settings, r)
         rounds.append(rnd)
+        if rnd.state.note:  # its state read at a sample, not the mean (map_fit.representative)
+            notes.append(f"round {r + 1}: {rnd.state.note}")
         det = rnd.detection
         # a candidate whose own score is significant is screened even where the family's
         # maximum is not: the evidence, not the detection, decides what is named
@@ -101,6 +104,9 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
         rnd.confirmed = confirm(now.fit, effects, now.priors, confirmation, scale,
                                 seed_offset=1000 * (r + 1), detection=det, screen=rnd.screen,
                                 top=settings.top)
+        # a name whose posterior diverges over the record is withdrawn (name.simulable)
+        notes += withdraw_divergent(rnd.confirmed, lambda s: analysis.chain(
+            start.detection_problem, start.temper, structure=s), confirmation)
         notes += rough_notes(rnd, r)
         best = rnd.accepted
         if best is None:
