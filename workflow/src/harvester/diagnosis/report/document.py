@@ -270,7 +270,10 @@ def _rounds(d) -> list[dict]:
                                       "trusted": rnd.screen.importance_check}),
              "accepted": rnd.accepted.effect if rnd.accepted else None,
              "named": bool(rnd.accepted and rnd.accepted.named),
-             "device_scale": asdict(rnd.scale) if rnd.scale is not None else None}
+             "device_scale": asdict(rnd.scale) if rnd.scale is not None else None,
+             # the accepted mode held against the output's sensor (name.sensor)
+             "sensor_resonance": (rnd.sensor.to_dict()
+                                  if getattr(rnd, "sensor", None) is not None else None)}
             for rnd in d.rounds]
 
 
