@@ -4,13 +4,15 @@ device read through a mass accelerometer resonating at 8 Hz (the literature gene
 the sensor's reading is found and beats the best-fitting mode in the device; on a device
 with a real second mass at 8 Hz, the mode beats every sensor reading."""
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
 from harvester.data.signals import lowpass
 from harvester.diagnosis.name.confirm import CandidateResult, ConfirmSettings
 from harvester.diagnosis.name.fits import ModelFit
-from harvester.diagnosis.name.sensor import (fit_sensor, hold_mode_against_sensor,
+from harvester.diagnosis.name.sensor import (fit_sensor, hold_against_sensor,
                                              read_resonance, sensor_response)
 from harvester.inference.likelihood import DAQ_OVERSAMPLE
 from harvester.inference.map_fit import ChainProblem, baseline_state, fit_map
@@ -57,16 +59,25 @@ def test_sensor_resonance_is_the_sensors(device):
     assert f_s == pytest.approx(8.0, rel=0.01) and zeta == pytest.approx(0.1, rel=0.05)
     assert sensor.startswith("the mass accelerometer")
     mode = mode_result(truth, output)
-    reading = read_resonance(state, mode, lambda s: mode.fit.problem, LOWPASS_HZ,
-                             ConfirmSettings())
+    reading = read_resonance(state, "unmodelled_mode", mode.fit.problem,
+                             mode.fit.samples.mean(axis=0), LOWPASS_HZ, ConfirmSettings())
     assert reading.conclusion == "sensor", reading.sentence()
-    assert reading.sensor_gain > reading.mode_gain + reading.margin
+    assert reading.sensor_gain > reading.device_gain + reading.margin
     other = CandidateResult("hysteresis", mode.fit, 50.0, 0.5, 6.0, True)
-    results = [mode, other]
-    held, notes = hold_mode_against_sensor(results, state, lambda s: mode.fit.problem,
-                                           LOWPASS_HZ, ConfirmSettings())
+    rnd = SimpleNamespace(confirmed=[mode, other], state=state, screen=None,
+                          detection=SimpleNamespace(significant=True))
+    held, notes = hold_against_sensor(rnd, lambda s: mode.fit.problem, LOWPASS_HZ,
+                                      ConfirmSettings())
     assert held.conclusion == "sensor" and not mode.accepted and other.accepted
     assert "not a mode of the device" in notes[0]
+    # nothing accepted: the round's best fit (a mode here) is what the sensor is held against
+    mode.accepted = other.accepted = False
+    best = SimpleNamespace(effect="hysteresis", failed=False, max_loglike=1.0,
+                           theta=mode.fit.samples.mean(axis=0))
+    rnd.screen = SimpleNamespace(candidates=[best])
+    held, notes = hold_against_sensor(rnd, lambda s: mode.fit.problem, LOWPASS_HZ,
+                                      ConfirmSettings())
+    assert held.conclusion == "sensor" and "the mismatch is the output sensor's" in notes[0]
 
 
 def test_device_mode_is_the_devices(device):
@@ -76,9 +87,15 @@ def test_device_mode_is_the_devices(device):
     output = lowpass(clean + noise, FS, LOWPASS_HZ, 8)
     state = baseline_state(chain(truth, "linear", output), np.array([[C_M, 0.05]]))
     mode = mode_result(truth, output)
-    reading = read_resonance(state, mode, lambda s: mode.fit.problem, LOWPASS_HZ,
-                             ConfirmSettings())
+    reading = read_resonance(state, "unmodelled_mode", mode.fit.problem,
+                             mode.fit.samples.mean(axis=0), LOWPASS_HZ, ConfirmSettings())
     assert reading.conclusion == "device", reading.sentence()
+    rnd = SimpleNamespace(confirmed=[mode], state=state, screen=None,
+                          detection=SimpleNamespace(significant=True))
+    held, notes = hold_against_sensor(rnd, lambda s: mode.fit.problem, LOWPASS_HZ,
+                                      ConfirmSettings())
+    assert held.conclusion == "device" and mode.accepted
+    assert notes[0].startswith("the resonance is the device's")
 
 
 def test_generator_reads_the_mass_through_its_accelerometer():

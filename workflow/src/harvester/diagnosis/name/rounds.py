@@ -25,7 +25,7 @@ from harvester.diagnosis.detect.scores import Detection, detect
 from harvester.diagnosis.name.rank import RankedCandidate, rank, rivals, to_confirm
 from harvester.diagnosis.name.screen import Screen, screen
 from harvester.diagnosis.name.simulable import withdraw_divergent
-from harvester.diagnosis.name.sensor import SensorReading, hold_mode_against_sensor
+from harvester.diagnosis.name.sensor import SensorReading, hold_against_sensor
 from harvester.diagnosis.prepare.settings import DiagnosisSettings
 from harvester.diagnosis.detect.signatures import candidate_terms, motion_scale
 from harvester.model.priors import DeviceScale
@@ -45,7 +45,7 @@ class Round:
     confirmed: list[CandidateResult] = field(default_factory=list)
     scale: DeviceScale | None = None  # the scales the candidates' priors were read on
     screen: Screen | None = None  # the candidates' best fits, in the order they were sampled
-    sensor: SensorReading | None = None  # the mode held against the output's sensor
+    sensor: SensorReading | None = None  # held against the output's sensor (name.sensor)
 
     @property
     def accepted(self) -> CandidateResult | None:
@@ -109,9 +109,9 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
         # a name whose posterior diverges over the record is withdrawn (name.simulable)
         notes += withdraw_divergent(rnd.confirmed, lambda s: analysis.chain(
             start.detection_problem, start.temper, structure=s), confirmation)
-        rnd.sensor, said = hold_mode_against_sensor(rnd.confirmed, rnd.state, lambda s: (
-            analysis.chain(start.detection_problem, start.temper, structure=s)),
-            analysis.f_high, confirmation)  # a sensor's resonance is not named (name.sensor)
+        rnd.sensor, said = hold_against_sensor(rnd, lambda s: analysis.chain(
+            start.detection_problem, start.temper, structure=s), analysis.f_high,
+            confirmation)  # a resonance of the output's sensor is not named (name.sensor)
         notes += said
         notes += rough_notes(rnd, r)
         best = rnd.accepted
