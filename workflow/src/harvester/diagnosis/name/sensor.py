@@ -135,18 +135,19 @@ def _readings(state: BaselineState) -> dict[str, Callable[[float, float], np.nda
 
 def fit_sensor(state: BaselineState, f_high: float) -> tuple[float, float, str, float]:
     """(f_s, zeta, which sensor, gain in nats) of the best sensor reading of the baseline's
-    output (grid over F_SPAN x f_high, ZETA_SPAN, then Nelder-Mead in the logs)."""
+    output (grid over F_SPAN x f_high, ZETA_SPAN, then Nelder-Mead in the logs, within
+    them)."""
     p, measured = state.problem, state.problem.measured_chain
     best = (np.nan, np.nan, "", -np.inf)
     for name, read in _readings(state).items():
         def loss(q):
             r = measured - read(float(np.exp(q[0])), float(np.exp(q[1])))
             return -_gain(p, state.residual, r)
-        grid = [(np.log(f), np.log(z))
-                for f in np.geomspace(F_SPAN[0] * f_high, F_SPAN[1] * f_high, 48)
-                for z in np.geomspace(*ZETA_SPAN, 8)]
+        span = [(np.log(F_SPAN[0] * f_high), np.log(F_SPAN[1] * f_high)),
+                tuple(np.log(ZETA_SPAN))]
+        grid = [(f, z) for f in np.linspace(*span[0], 48) for z in np.linspace(*span[1], 8)]
         start = min(grid, key=loss)
-        res = optimize.minimize(loss, start, method="Nelder-Mead",
+        res = optimize.minimize(loss, start, method="Nelder-Mead", bounds=span,
                                 options={"xatol": 1e-4, "fatol": 1e-3, "maxiter": 400})
         if -res.fun > best[3]:
             best = (float(np.exp(res.x[0])), float(np.exp(res.x[1])), name, float(-res.fun))
