@@ -70,6 +70,13 @@ def test_sensor_resonance_is_the_sensors(device):
                                       ConfirmSettings())
     assert held.conclusion == "sensor" and not mode.accepted and other.accepted
     assert "not a mode of the device" in notes[0]
+    # another accepted effect (its fit here the mode's) is held against the sensor the same way
+    other.accepted = True
+    rnd.confirmed = [other]
+    held, notes = hold_against_sensor(rnd, lambda s: mode.fit.problem, LOWPASS_HZ,
+                                      ConfirmSettings())
+    assert held.conclusion == "sensor" and not other.accepted
+    assert "not hysteresis" in notes[0] and "hysteresis not named" in notes[0]
     # nothing accepted: the round's best fit (a mode here) is what the sensor is held against
     mode.accepted = other.accepted = False
     best = SimpleNamespace(effect="hysteresis", failed=False, max_loglike=1.0,

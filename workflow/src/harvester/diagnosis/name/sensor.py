@@ -21,8 +21,11 @@ one ``confirm.mark_ties`` asks of one named model over another), the device's wh
 gains more by that margin; in between one output channel does not tell them apart, and the
 mode's name carries that caveat.
 
-Where the round accepts nothing while the detection finds a mismatch, the sensor's reading is
-held the same way against the library's best fit of the round (the screened candidate of the
+Any other accepted candidate is held the same way: a sensor's resonance distorts the output
+everywhere, and a friction law or a spring fitted to that distortion is a wrong name (a 45 Hz
+accelerometer on an effect-free record had hysteresis named at +22.6 nats). Where the round
+accepts nothing while the detection finds a mismatch, the sensor's reading is held the same
+way against the library's best fit of the round (the screened candidate of the
 largest likelihood at its MAP): a resonance of the sensor then leaves "the library explains
 none of the mismatch" with its cause. By MAP on the literature generator's records (tanh
 baseline, fast settings, ``docs/measurements.md``): a 45 Hz accelerometer (zeta 0.05) on
@@ -88,7 +91,8 @@ class SensorReading:
     accepted: bool = True
 
     def sentence(self) -> str:
-        rival = ("a mode in the device" if self.accepted else
+        rival = ("a mode in the device" if self.accepted and self.effect == MODE else
+                 f"{self.effect} in the device" if self.accepted else
                  f"the library's best fit ({self.effect})")
         gains = (f"the output read through a sensor resonating at {self.f_hz:.3g} Hz "
                  f"(zeta {self.zeta:.2g}, {self.sensor}) gains {self.sensor_gain:+.1f} nats "
@@ -96,6 +100,8 @@ class SensorReading:
         if not self.accepted:
             return (f"the mismatch is the output sensor's own resonance, not the device's: "
                     f"{gains} (the library models the device, not its sensors)")
+        if self.effect != MODE:
+            return self._effect_sentence(gains)
         if self.conclusion == "sensor":
             return (f"the resonance is the output sensor's, not a mode of the device: {gains}; "
                     f"{MODE} not named (the library models the device, not its sensors)")
@@ -105,6 +111,16 @@ class SensorReading:
                 f"{gains}, within the {self.margin:.1f}-nat margin; one output channel does not "
                 "tell them apart here (a second sensor on the mass, or the sensor's "
                 "calibration, would)")
+
+    def _effect_sentence(self, gains: str) -> str:
+        if self.conclusion == "sensor":
+            return (f"the mismatch is the output sensor's own resonance, not {self.effect}: "
+                    f"{gains}; {self.effect} not named (the library models the device, not "
+                    "its sensors)")
+        if self.conclusion == "undecided":
+            return (f"the mismatch may be the output sensor's resonance as well as "
+                    f"{self.effect}: {gains}, within the {self.margin:.1f}-nat margin")
+        return f"the mismatch is {self.effect}'s, not the output sensor's: {gains}"
 
     def to_dict(self) -> dict:
         return {"f_hz": self.f_hz, "zeta": self.zeta, "sensor": self.sensor,
@@ -179,12 +195,13 @@ def read_resonance(state: BaselineState, effect: str, problem: ChainProblem,
 
 
 def _rival(rnd, problem_of) -> tuple[str, ChainProblem, np.ndarray, bool] | None:
-    """What the sensor is held against: the accepted mode at its posterior, or, where the
-    round accepted nothing but detected a mismatch, its best screened fit at its MAP."""
+    """What the sensor is held against: the accepted candidate at its posterior, or, where
+    the round accepted nothing but detected a mismatch, its best screened fit at its MAP."""
     accepted = [r for r in rnd.confirmed if r.accepted]
-    if accepted and accepted[0].effect == MODE:
+    if accepted:
         problem = problem_of(accepted[0].fit.structure)
-        return MODE, problem, representative(problem, accepted[0].fit.samples)[0], True
+        return (accepted[0].effect, problem,
+                representative(problem, accepted[0].fit.samples)[0], True)
     fits = [] if rnd.screen is None else [s for s in rnd.screen.candidates if not s.failed]
     if accepted or not rnd.detection.significant or not fits:
         return None
@@ -198,8 +215,9 @@ def hold_against_sensor(rnd, problem_of: Callable[[ModelStructure], ChainProblem
                         ) -> tuple[SensorReading | None, list[str]]:
     """Hold the round (``rounds.Round``: its confirmed candidates, best first, its state,
     detection and screen) against a resonance of the output's sensor (:func:`_rival`,
-    :func:`read_resonance`); withdraw an accepted mode where the resonance is the sensor's.
-    (the reading or None, notes: the mode's reading, or the sensor's where it wins)."""
+    :func:`read_resonance`); withdraw the accepted candidate where the mismatch is the
+    sensor's. (the reading or None, notes: a mode's reading, or any where the sensor is not
+    ruled out)."""
     try:
         rival = _rival(rnd, problem_of)
         if rival is None:
@@ -211,6 +229,6 @@ def hold_against_sensor(rnd, problem_of: Callable[[ModelStructure], ChainProblem
         return None, [f"the mismatch was not held against the output's sensor: {err}"]
     log.info("%s", reading.sentence())
     if reading.accepted and reading.conclusion == "sensor":
-        withdraw(rnd.confirmed, [MODE], settings)
-    said = reading.accepted or reading.conclusion == "sensor"
+        withdraw(rnd.confirmed, [reading.effect], settings)
+    said = reading.effect == MODE and reading.accepted or reading.conclusion != "device"
     return reading, [reading.sentence()] if said else []
