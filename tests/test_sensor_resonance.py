@@ -116,3 +116,22 @@ def test_generator_reads_the_mass_through_its_accelerometer():
         np.std(change[int(read.truth["lead_in_s"] * 256):]) / read.truth["noise_rms_rel_acc"],
         rel=0.05)
     assert read.truth["sensor_resonance"]["change_to_noise"] > 0.1
+
+
+def test_a_reading_without_a_resonance_rules_the_sensor_out(device, monkeypatch):
+    """A best sensor reading whose damping lies on the span's top is no resonance: the
+    device's effect keeps its name whatever the gains (LuGre's record, measurements.md)."""
+    import harvester.diagnosis.name.sensor as sensor
+    truth, noise = device
+    output = lowpass(truth["a"] + noise, FS, LOWPASS_HZ, 8)
+    state = baseline_state(chain(truth, "linear", output), np.array([[C_M, 0.05]]))
+    monkeypatch.setattr(sensor, "fit_sensor", lambda st, f: (30.0, 0.25, "the output's sensor",
+                                                             60.0))
+    monkeypatch.setattr(sensor, "device_gain", lambda st, p, th: 40.0)
+    reading = sensor.read_resonance(state, "hysteresis", None, None, LOWPASS_HZ,
+                                    ConfirmSettings())
+    assert reading.conclusion == "device" and "no resonance" in reading.sentence()
+    monkeypatch.setattr(sensor, "fit_sensor", lambda st, f: (30.0, 0.05, "the output's sensor",
+                                                             60.0))
+    assert sensor.read_resonance(state, "hysteresis", None, None, LOWPASS_HZ,
+                                 ConfirmSettings()).conclusion == "sensor"
