@@ -135,3 +135,9 @@ def test_a_reading_without_a_resonance_rules_the_sensor_out(device, monkeypatch)
                                                              60.0))
     assert sensor.read_resonance(state, "hysteresis", None, None, LOWPASS_HZ,
                                  ConfirmSettings()).conclusion == "sensor"
+    # the round's best fit (nothing accepted) that beats the sensor rules it out, in words too
+    monkeypatch.setattr(sensor, "device_gain", lambda st, p, th: 600.0)
+    best = sensor.read_resonance(state, "inertia_error", None, None, LOWPASS_HZ,
+                                 ConfirmSettings(), accepted=False)
+    assert best.conclusion == "device"
+    assert best.sentence().startswith("the mismatch is not the output sensor's")

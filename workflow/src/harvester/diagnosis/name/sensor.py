@@ -108,8 +108,14 @@ class SensorReading:
                  f"(zeta {self.zeta:.2g}, {self.sensor}) gains {self.sensor_gain:+.1f} nats "
                  f"over the model without it, {rival} {self.device_gain:+.1f}")
         if not self.accepted:
-            return (f"the mismatch is the output sensor's own resonance, not the device's: "
-                    f"{gains} (the library models the device, not its sensors)")
+            return {"sensor": "the mismatch is the output sensor's own resonance, not the "
+                              f"device's: {gains} (the library models the device, not its "
+                              "sensors)",
+                    "device": f"the mismatch is not the output sensor's: {gains}"
+                              + self._no_peak(),
+                    "undecided": "the mismatch may be the output sensor's resonance: "
+                                 f"{gains}, within the {self.margin:.1f}-nat margin"
+                    }[self.conclusion]
         if self.effect != MODE:
             return self._effect_sentence(gains)
         if self.conclusion == "sensor":
