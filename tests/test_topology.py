@@ -1,6 +1,7 @@
 """What the friction acts on, when the sidecar does not say (``diagnosis.prepare.topology``): a
 frame-like device written here, friction on the velocity relative to the base or to the
-ground, recorded as laser displacements (base_disp -> rel_disp), must be given its own form."""
+ground, recorded as laser displacements (base_disp -> rel_disp) or with an accelerometer on
+the mass (base_disp -> rel_acc), must be given its own form."""
 
 import numpy as np
 import pandas as pd
@@ -27,9 +28,10 @@ def _base(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return y, yd, ydd
 
 
-def frame_record(on: str, seed: int = 0) -> pd.DataFrame:
+def frame_record(on: str, seed: int = 0, output: str = "rel_disp") -> pd.DataFrame:
     """M z'' + C z' + k z + F tanh(v / V_SMOOTH) = -M y'', v = z' (on the base) or z' + y'
-    (on the ground); laser noise 5 um on both channels, low-passed at CUT Hz."""
+    (on the ground); laser noise 5 um on both channels (the output: or an accelerometer's
+    0.02 m/s^2 on z''), low-passed at CUT Hz."""
     M, k = DEVICE["M"], DEVICE["k"]
 
     def rhs(t, s):
@@ -42,9 +44,13 @@ def frame_record(on: str, seed: int = 0) -> pd.DataFrame:
                     atol=1e-11, max_step=1e-3)
     rng = np.random.default_rng(seed)
     y = _base(t)[0] + 5e-6 * rng.standard_normal(t.size)
-    z = sol.y[0] + 5e-6 * rng.standard_normal(t.size)
+    if output == "rel_disp":
+        z = sol.y[0] + 5e-6 * rng.standard_normal(t.size)
+    else:
+        z = np.array([rhs(ti, si)[1] for ti, si in zip(t, sol.y.T)])
+        z = z + 0.02 * rng.standard_normal(t.size)
     return pd.DataFrame({"time": t, "base_disp": lowpass(y, FS, CUT, 8),
-                         "rel_disp": lowpass(z, FS, CUT, 8)})
+                         output: lowpass(z, FS, CUT, 8)})
 
 
 def _choose(df: pd.DataFrame):
@@ -66,3 +72,11 @@ def test_each_form_is_told_by_its_evidence(on):
     assert choice.chosen == on, choice.to_dict()
     assert abs(choice.lead) > 3 * choice.threshold
     assert "taken: relative to the " + on in choice.sentence("<frame>")
+
+
+@pytest.mark.parametrize("on", ["base", "ground"])
+def test_each_form_is_told_on_an_acceleration_output(on):
+    """base_disp -> rel_acc: the ground form reads x'' = z'' + y'' (y'' differentiated)."""
+    choice = _choose(frame_record(on, output="rel_acc"))
+    assert choice.chosen == on, choice.to_dict()
+    assert abs(choice.lead) > 3 * choice.threshold

@@ -474,7 +474,8 @@ class BaselineState:
     All arrays over the problem's (possibly shortened) record; z'', the model's output (of
     the recording's output kind: z'' or z, ``harvester.data.kinds``) and the residual through
     the measurement chain; ``theta`` = (free parameters..., sigma); ``theta_sd`` the
-    posterior sd of each; ``samples`` posterior draws (rows like theta).
+    posterior sd of each; ``samples`` posterior draws (rows like theta); ``note`` says where
+    theta is not the posterior mean (:func:`representative`), None where it is.
     """
 
     problem: ChainProblem
@@ -487,6 +488,7 @@ class BaselineState:
     residual: np.ndarray
     jacobian: np.ndarray = field(repr=False)
     output: np.ndarray | None = field(default=None, repr=False)  # None: rel_acc is the output
+    note: str | None = None
 
     def __post_init__(self) -> None:
         if self.output is None:
@@ -497,16 +499,46 @@ class BaselineState:
         return self.problem.parameter_names
 
 
-def baseline_state(problem: ChainProblem, samples: np.ndarray) -> BaselineState:
-    """Posterior mean, its simulated response and residual, and the sensitivities there."""
-    samples = np.atleast_2d(np.asarray(samples, dtype=float))
+def representative(problem: ChainProblem, samples: np.ndarray) -> tuple[np.ndarray, str | None]:
+    """(theta at which the baseline's state is read, a note or None): the posterior mean
+    where it can be simulated over the problem's record, else the posterior sample that fits
+    the record best (highest likelihood; the note says how many samples could be simulated).
+
+    The mean of simulable samples need not be simulable: a posterior with two modes (chains
+    that found different ones) has its mean between them, and samples drawn on the TMCMC
+    window may blow up over the longer record the detection reads (a softening spring whose
+    well the larger motion leaves). Raises RuntimeError where no sample can be simulated.
+    """
     theta = samples.mean(axis=0)
+    if problem.simulate(theta).ok[0]:
+        return theta, None
+    ll = problem.loglike(samples)
+    good = np.isfinite(ll)
+    name = problem.structure.name
+    if not good.any():
+        raise RuntimeError(f"neither the posterior mean of {name} nor any of its "
+                           f"{len(samples)} posterior samples can be simulated over the record")
+    note = (f"the posterior mean of {name} cannot be simulated over the record "
+            f"({int(good.sum())} of {len(samples)} posterior samples can); its state, "
+            "residual and sensitivities are read at the posterior sample that fits the "
+            "record best")
+    log.warning("%s", note)
+    return samples[int(np.argmax(np.where(good, ll, -np.inf)))].copy(), note
+
+
+def baseline_state(problem: ChainProblem, samples: np.ndarray) -> BaselineState:
+    """The baseline's state at a representative of its posterior (:func:`representative`:
+    the posterior mean, or where that cannot be simulated the best-fitting sample, said in
+    ``note``), its simulated response and residual, and the sensitivities there."""
+    samples = np.atleast_2d(np.asarray(samples, dtype=float))
+    theta, note = representative(problem, samples)
     sd = samples.std(axis=0, ddof=1) if len(samples) > 1 else np.abs(theta) * 0.01
     sim = problem.simulate(theta)
-    if not sim.ok[0]:
-        raise RuntimeError(f"the posterior mean of {problem.structure.name} cannot be simulated")
+    if not sim.ok[0]:  # a sample that simulated in the batch but not alone
+        raise RuntimeError(f"{problem.structure.name} cannot be simulated at its "
+                           "representative posterior sample")
     model = problem.chain(problem.output_type.simulated(sim)[0])
     jac = sensitivities(problem, theta, sd)
     return BaselineState(problem, theta, sd, samples, sim.rel_disp[0], sim.rel_vel[0],
                          problem.chain(sim.rel_acc[0]), problem.measured_chain - model, jac,
-                         model)
+                         model, note)

@@ -1430,14 +1430,29 @@ def _streams(name: str, seed: int) -> list[np.random.Generator]:
     return [np.random.default_rng(s) for s in seq.spawn(4)]
 
 
+def accelerometer(x: np.ndarray, fs: float, f_hz: float, zeta: float) -> np.ndarray:
+    """An accelerometer's mechanical response to the acceleration ``x`` sampled at ``fs``:
+    a seismic mass on its own spring, H(s) = w^2 / (s^2 + 2 zeta w s + w^2) (unit gain below
+    its resonance f_hz, a peak of 1 / (2 zeta) at it, falling as (f_hz / f)^2 above; Bendat
+    and Piersol 2010, sec. 2.4), causal, from rest; bilinear, its frequency pre-warped so
+    that the resonance lies at f_hz exactly."""
+    w = 2.0 * fs * np.tan(np.pi * f_hz / fs)
+    b, a = signal.bilinear([w * w], [1.0, 2.0 * zeta * w, w * w], fs)
+    return signal.lfilter(b, a, x)
+
+
 def _record(run: _Run, cal: _Calibrated, noise: tuple[np.ndarray, np.ndarray],
-            lsb: float | None) -> pd.DataFrame:
-    """Both channels through the DAQ, plus noise (and quantisation); rel = mass - base."""
+            lsb: float | None, sensor: tuple[float, float] | None = None) -> pd.DataFrame:
+    """Both channels through the DAQ, plus noise (and quantisation); rel = mass - base. The
+    mass accelerometer reads the mass's absolute acceleration through its own resonance
+    ``sensor`` = (f Hz, zeta) where given (:func:`accelerometer`; its electrical noise is
+    added after it)."""
     tb = run.tb
     _, acc, _, _ = run.output(cal.kind, cal.p, cal.n_sub, internal=True)
     y = run.base_internal()
     base = daq(y, tb.n_out) + noise[0]
-    mass = daq(acc + y, tb.n_out) + noise[1]
+    x = acc + y if sensor is None else accelerometer(acc + y, 1.0 / tb.h_int, *sensor)
+    mass = daq(x, tb.n_out) + noise[1]
     if lsb is not None:
         base, mass = np.round(base / lsb) * lsb, np.round(mass / lsb) * lsb
     return pd.DataFrame({"time": np.arange(tb.n_out) / tb.fs, "base_acc": base,
@@ -1446,8 +1461,8 @@ def _record(run: _Run, cal: _Calibrated, noise: tuple[np.ndarray, np.ndarray],
 
 def generate(name: str, seed: int, ratio: float = 0.5, duration_s: float = 40.0,
              fs: float = 256.0, noise_rel_acc: float = 0.09, lsb: float | None = None,
-             friction_form: str = "tanh", shared_input_noise: bool = True
-             ) -> GeneratedRecording:
+             friction_form: str = "tanh", shared_input_noise: bool = True,
+             sensor_resonance: tuple[float, float] | None = None) -> GeneratedRecording:
     """A recording of a device drawn for ``seed`` with the scenario ``name``'s effect.
 
     The effect's contribution to the recorded rel_acc has RMS = ratio x the rel_acc noise's
@@ -1461,7 +1476,10 @@ def generate(name: str, seed: int, ratio: float = 0.5, duration_s: float = 40.0,
     sensor's noise is in both (a rig with two accelerometers); False: the base channel is
     noise-free and the mass sensor carries sqrt(2) x its noise, the same rel_acc noise drawn
     from the same stream but independent of the input (a relative sensor). The device, the
-    excitation and the effect are the same either way.
+    excitation and the effect are the same either way. ``sensor_resonance`` (f Hz, zeta): the
+    mass accelerometer's own resonance (:func:`accelerometer`), on the output channel only, a
+    second departure outside the device; the truth's ``sensor_resonance`` gives its change of
+    the recorded rel_acc over the noise RMS.
     """
     if name not in SCENARIOS:
         raise ValueError(f"unknown scenario {name!r}; known: {', '.join(SCENARIOS)}")
@@ -1492,7 +1510,12 @@ def generate(name: str, seed: int, ratio: float = 0.5, duration_s: float = 40.0,
     truth = _truth(scen, seed, run, cal, contribution, jac, noise_rms, sensor, lsb, ratio)
     truth["effect"]["device_draws"] = device_draw
     sidecar = {"M": device.M, "m": device.m, "k": device.k}
-    recording = _record(run, cal, noise, lsb)
+    recording = _record(run, cal, noise, lsb, sensor_resonance)
+    if sensor_resonance is not None:
+        change = recording["rel_acc"] - _record(run, cal, noise, lsb)["rel_acc"]
+        truth["sensor_resonance"] = {"f_hz": float(sensor_resonance[0]),
+                                     "zeta": float(sensor_resonance[1]),
+                                     "change_to_noise": _rms(change[tb.window]) / noise_rms}
     driven = recorded_input_contribution(run, cal, recording["base_acc"].to_numpy())
     truth["input_driven_to_clean_contribution"] = (
         _rms((driven - contribution)[tb.window]) / max(_rms(contribution[tb.window]), 1e-300))

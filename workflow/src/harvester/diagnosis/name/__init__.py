@@ -9,6 +9,8 @@
 ``budget``       the search's time budget: its deadline, what it left unfinished
 ``plausibility`` a candidate's implied device (masses, stiffness) against the sidecar's
                  measurements: a name whose device contradicts them is not given
+``simulable``    a candidate whose posterior diverges over the record is withdrawn
+``sensor``       an accepted mode held against a resonance of the output's sensor
 ``rounds``       detect -> rank -> screen -> confirm, one effect added per round
 ``separate``     the measurement that would tell two tied effects apart
 ``verdict``      what is concluded: the verdict, the names, the ties, what is withheld

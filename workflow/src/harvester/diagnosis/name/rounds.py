@@ -28,6 +28,8 @@ from harvester.diagnosis.detect.scores import Detection, detect
 from harvester.diagnosis.name.rank import (RankedCandidate, limit_rivals, rank, rivals,
                                            to_confirm)
 from harvester.diagnosis.name.screen import Screen, screen
+from harvester.diagnosis.name.simulable import withdraw_divergent
+from harvester.diagnosis.name.sensor import SensorReading, hold_against_sensor
 from harvester.diagnosis.prepare.settings import DiagnosisSettings
 from harvester.diagnosis.detect.signatures import candidate_terms, motion_scale
 from harvester.model.priors import DeviceScale
@@ -49,6 +51,7 @@ class Round:
     screen: Screen | None = None  # the candidates' best fits, in the order they were sampled
     unfinished: list[Unfinished] = field(default_factory=list)  # what the budget cut
     seconds: dict[str, float] = field(default_factory=dict)  # detect, screen, confirm
+    sensor: SensorReading | None = None  # held against the output's sensor (name.sensor)
 
     @property
     def accepted(self) -> CandidateResult | None:
@@ -80,6 +83,8 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
     for r in range(settings.rounds + 1):
         rnd = detect_round(analysis, start, now, settings, r)
         rounds.append(rnd)
+        if rnd.state.note:  # its state read at a sample, not the mean (map_fit.representative)
+            notes.append(f"round {r + 1}: {rnd.state.note}")
         det = rnd.detection
         # a candidate whose own score is significant is screened even where the family's
         # maximum is not: the evidence, not the detection, decides what is named
@@ -105,8 +110,8 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
             unexplained = unexplained or det.significant
             notes.append(cut_round(rnd, effects, r, settings))
             break
-        best = sample_round(rnd, now, effects, analysis, settings, floor, r)
-        notes += rough_notes(rnd, r)
+        best, said = sample_round(rnd, now, effects, analysis, start, settings, floor, r)
+        notes += said + rough_notes(rnd, r)
         if best is None:
             unexplained = unexplained or det.significant
             notes += undecided_notes(rnd, r, settings)
@@ -118,9 +123,12 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
 
 
 def sample_round(rnd: Round, now: Current, effects: list[str], analysis: Analysis,
-                 settings: DiagnosisSettings, floor, r: int) -> CandidateResult | None:
-    """The round's screen and confirmation of ``effects`` on the current structure; the
-    accepted candidate (None: none)."""
+                 start: BaselineStart, settings: DiagnosisSettings, floor, r: int
+                 ) -> tuple[CandidateResult | None, list[str]]:
+    """The round's screen and confirmation of ``effects`` on the current structure, a name
+    whose posterior diverges over the record withdrawn (``simulable``) and the round held
+    against a resonance of the output's sensor (``sensor``): (the accepted candidate or
+    None, notes)."""
     det = rnd.detection
     begun = time.perf_counter()
     scale = rnd.scale = motion_scale(rnd.state, analysis.window, det.frame.f_high)
@@ -136,8 +144,14 @@ def sample_round(rnd: Round, now: Current, effects: list[str], analysis: Analysi
                             seed_offset=1000 * (r + 1), detection=det, screen=rnd.screen,
                             top=settings.top, unfinished=rnd.unfinished,
                             where=f"round {r + 1}")
+
+    def chain(structure):
+        return analysis.chain(start.detection_problem, start.temper, structure=structure)
+    # a name whose posterior diverges over the record is withdrawn (name.simulable)
+    notes = withdraw_divergent(rnd.confirmed, chain, confirmation)
+    rnd.sensor, said = hold_against_sensor(rnd, chain, analysis.f_high, confirmation)
     rnd.seconds["confirm"] = time.perf_counter() - begun - rnd.seconds["screen"]
-    return rnd.accepted
+    return rnd.accepted, notes + said
 
 
 def cut_round(rnd: Round, effects: list[str], r: int, settings: DiagnosisSettings) -> str:

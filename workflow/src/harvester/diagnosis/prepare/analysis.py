@@ -328,6 +328,8 @@ def start_baseline(analysis: Analysis, priors: Mapping[str, PriorSpec] | None,
     specs = {**default_priors(a.structure, float(np.mean(samples[:, -1])),
                               a.fit_raw.output_type.unit), **priors}
     state = baseline_state(a.chain(a.detection_raw, 1.0), samples)
+    if state.note:
+        a.notes.append(state.note)
     temper = estimate_temper(state.residual, a.window, a.fs, a.f_high)
     ev = float(np.mean(idata_log_evidence(posterior))) \
         if "sample_stats" in posterior.groups() else float("nan")

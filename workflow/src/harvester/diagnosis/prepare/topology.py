@@ -2,10 +2,13 @@
 base (eq. 1 of Green et al. 2015, a screw between the base and the mass) or the mass's own
 velocity (a contact fixed to the ground, as on the frame of Marino and Cicirello 2023).
 
-Both forms are candidates of one recording (base_disp -> rel_disp, k known): the recording as
-it is, and rewritten in absolute coordinates (``harvester.data.kinds.on_ground``: driven by
-k y, output x = z + y). Each form's model is the baseline with a sliding friction law (the
-baseline's own, or ``coulomb_friction`` when it has none), fitted at its posterior mode; the
+Both forms are candidates of one recording (base_disp -> rel_disp or rel_acc, k known): the
+recording as it is, and rewritten in absolute coordinates (``harvester.data.kinds.on_ground``:
+driven by k y, output x = z + y, or x'' = z'' + y'' with y'' differentiated from the recorded
+y). With a force input the base is fixed and both forms are one; a base acceleration does not
+fix y (its double integral drifts, ``on_ground``), so neither is compared. Each form's model
+is the baseline with a sliding friction law (the baseline's own, or ``coulomb_friction`` when
+it has none), fitted at its posterior mode; the
 forms are compared by the Laplace approximation of their evidence (``baseline.
 laplace_log_evidence``) under one likelihood: the same samples, low-pass, tempering lambda and
 noise prior. x and z differ by the recorded y, a shift with unit Jacobian, so the two
@@ -71,10 +74,11 @@ class TopologyChoice:
 
 def comparable(df: pd.DataFrame, known: Mapping[str, float], source: str = "<recording>"
                ) -> bool:
-    """Whether both forms can be compared: base_disp -> rel_disp with k known."""
+    """Whether both forms can be compared: base_disp -> rel_disp or rel_acc with k known."""
     from harvester.data.recording import recording_kinds
     kinds = recording_kinds(df, source)
-    return (kinds.input_kind, kinds.output_kind) == ("base_disp", "rel_disp") and "k" in known
+    return kinds.input_kind == "base_disp" and kinds.output_kind in ("rel_disp", "rel_acc") \
+        and "k" in known
 
 
 def friction_structure(baseline: str) -> str:
@@ -106,11 +110,13 @@ def choose_topology(df: pd.DataFrame, known: Mapping[str, float], baseline: str,
     s = friction_structure(baseline)
     forms = {f: _form(df, known, f, source) for f in FORMS}
     if settings.lowpass_hz is None:  # one low-pass for both: the recording's, as recorded
+        from harvester.data.recording import recording_kinds
         from harvester.data.signals import uniform_step
         from harvester.diagnosis.detect.spectral import recording_lowpass
         dt = uniform_step(df["time"].to_numpy(dtype=float), source)
+        output = recording_kinds(df, source).output_kind
         settings = replace(settings, lowpass_hz=recording_lowpass(
-            None, df["base_disp"].to_numpy(dtype=float), df["rel_disp"].to_numpy(dtype=float),
+            None, df["base_disp"].to_numpy(dtype=float), df[output].to_numpy(dtype=float),
             1.0 / dt)[0])
     # per form: its analysis and priors, once; the mode at lambda = 1 sets lambda and sigma
     prepared = {f: (prepare(forms[f][0], None, s, forms[f][1], settings, source),

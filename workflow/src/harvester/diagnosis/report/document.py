@@ -271,7 +271,10 @@ def _rounds(d) -> list[dict]:
              "accepted": rnd.accepted.effect if rnd.accepted else None,
              "named": bool(rnd.accepted and rnd.accepted.named),
              "device_scale": asdict(rnd.scale) if rnd.scale is not None else None,
-             "seconds": dict(rnd.seconds)}
+             "seconds": dict(rnd.seconds),
+             # the accepted mode held against the output's sensor (name.sensor)
+             "sensor_resonance": (rnd.sensor.to_dict()
+                                  if getattr(rnd, "sensor", None) is not None else None)}
             for rnd in d.rounds]
 
 
