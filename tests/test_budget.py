@@ -15,7 +15,7 @@ from harvester.cli import main
 from harvester.data.daq import write_recording
 from harvester.diagnosis import DiagnosisSettings, diagnose_recording
 from harvester.diagnosis.name.budget import (BUDGET_MAX_S, BUDGET_MIN_S, Unfinished,
-                                             budget_seconds, search_seconds, spent,
+                                             budget_dict, budget_seconds, search_seconds, spent,
                                              with_deadline)
 from harvester.diagnosis.report.document import validate_document
 from harvester.inference.tmcmc import TMCMC, OutOfTime, run_tmcmc
@@ -135,14 +135,21 @@ def test_the_command_line_takes_a_budget_or_none(record, tmp_path, capsys):
                   "--out", str(tmp_path / bad)])
         assert exit_.value.code == 2
         assert "expected seconds > 0 or 'none'" in capsys.readouterr().err
-    code = main(["diagnose", str(record), "--baseline", "linear", "--out", str(tmp_path / "n"),
-                 "--fast", "--no-figures", "--particles", "40", "--chains", "1", "--top", "1",
-                 "--rounds", "1", "--candidates", "coulomb_friction", "--budget", "none"])
-    assert code == 0
-    doc = json.loads((tmp_path / "n" / "diagnosis.json").read_text())
-    assert doc["budget"]["seconds"] is None and doc["settings"]["budget"] is False
-    assert not doc["budget"]["cut"] and doc["budget"]["unfinished"] == []
-    assert "time budget" not in doc["headline"]
+    from harvester.cli import _diagnosis_settings, _parser
+
+    def settings(*extra):
+        args = _parser().parse_args(["diagnose", str(record), "--baseline", "linear",
+                                     "--out", str(tmp_path / "x"), *extra])
+        return _diagnosis_settings(args)
+    assert (settings().budget, settings().budget_s) == (True, None)  # from the record's length
+    assert (settings("--budget", "none").budget, settings("--budget", "90").budget_s) == (
+        False, 90.0)
+
+
+def test_the_budget_section_without_a_budget():
+    doc = budget_dict(DiagnosisSettings(budget=False), 10.0, 3.0, [])
+    assert doc == {"seconds": None, "search_budget_seconds": None, "search_seconds": 3.0,
+                   "cut": False, "unfinished": [], "timeline": []}
 
 
 def test_an_unfinished_step_in_words():
