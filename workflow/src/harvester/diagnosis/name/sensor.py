@@ -12,7 +12,8 @@ The test holds the two physical readings against the same record. The sensor's: 
 the mode was added to, at its posterior, its output read through H (f_s, zeta fitted by least
 squares over the detection window; on a rig whose output is the mass accelerometer less the
 base's, the mass accelerometer reads the absolute acceleration: y = H (z'' + y'') - y''). The
-device's: the structure with the mode, at its posterior (``map_fit.representative``). Each is
+device's: the structure with the mode at the best of its posterior's representative draw
+(``map_fit.representative``) and DEVICE_DRAWS draws, as the sensor's is its best fit. Each is
 scored by its gain of tempered log-likelihood over the model without the mode (sigma profiled:
 lambda n/2 log(sse_before / sse)). The sensor's reading has two parameters and none of the
 device's refitted, the mode four and all of them refitted: the resonance is said to be the
@@ -53,6 +54,10 @@ from harvester.model.structures import ModelStructure
 
 log = logging.getLogger("harvester.diagnosis")
 
+#: Posterior draws of an accepted candidate read beside its representative draw: the device's
+#: best reading is the best of them (on the frame at 250 g the posterior mean of hysteresis
+#: fitted 57 nats worse than the linear model, its evidence +7.5 nats better).
+DEVICE_DRAWS = 64
 #: The effect a sensor's resonance is held against.
 MODE = "unmodelled_mode"
 #: The sensor's resonance searched over the mode prior's span (``unmodelled_mode``: a
@@ -195,12 +200,16 @@ def fit_sensor(state: BaselineState, f_high: float) -> tuple[float, float, str, 
 
 
 def device_gain(state: BaselineState, problem: ChainProblem, theta: np.ndarray) -> float:
-    """The gain (tempered nats) over ``state``'s model of ``problem``'s structure at
-    ``theta``, on the same record; RuntimeError where it cannot be simulated."""
-    pred, ok = problem.predicted(np.atleast_2d(theta))
-    if not ok[0]:
+    """The gain (tempered nats) over ``state``'s model of ``problem``'s structure at the best
+    of the rows of ``theta`` (a fit, or posterior draws: the device's best reading, as the
+    sensor's is its best fit), on the same record; RuntimeError where none can be
+    simulated."""
+    rows = np.atleast_2d(theta)
+    pred, ok = problem.predicted(rows)
+    if not np.any(ok):
         raise RuntimeError(f"{problem.structure.name} cannot be simulated at its fit")
-    return _gain(state.problem, state.residual, problem.measured_chain - pred[0])
+    return max(_gain(state.problem, state.residual, problem.measured_chain - pred[i])
+               for i in np.flatnonzero(ok))
 
 
 def read_resonance(state: BaselineState, effect: str, problem: ChainProblem,
@@ -224,8 +233,11 @@ def _rival(rnd, problem_of) -> tuple[str, ChainProblem, np.ndarray, bool] | None
     accepted = [r for r in rnd.confirmed if r.accepted]
     if accepted:
         problem = problem_of(accepted[0].fit.structure)
-        return (accepted[0].effect, problem,
-                representative(problem, accepted[0].fit.samples)[0], True)
+        draws = accepted[0].fit.samples
+        pick = np.random.default_rng(0).choice(len(draws), min(DEVICE_DRAWS, len(draws)),
+                                              replace=False)
+        rows = np.vstack([representative(problem, draws)[0], draws[pick]])
+        return accepted[0].effect, problem, rows, True
     fits = [] if rnd.screen is None else [s for s in rnd.screen.candidates if not s.failed]
     if accepted or not rnd.detection.significant or not fits:
         return None
