@@ -1493,18 +1493,9 @@ def generate(name: str, seed: int, ratio: float = 0.5, duration_s: float = 40.0,
     if not shared_input_noise:
         noise = (0.0 * noise[0], np.sqrt(2.0) * noise[1])
     noise_rms = _rms((noise[1] - noise[0])[tb.window])
-    for device_draw in range(1, MAX_DEVICE_DRAWS + 1):
-        device = draw_device(rng_device, noise_rel_acc, friction_form)
-        run = _Run(draw_excitation(rng_excitation, device, tb.period, duration_s, fs), tb)
-        device = settle_v_t(run, device)
-        try:
-            cal = _calibrate(run, scen, device, rng_shape, ratio * noise_rms, noise_rms)
-            break
-        except UnreachableRatio:
-            continue
-    else:
-        raise UnreachableRatio(f"{name}: no device in {MAX_DEVICE_DRAWS} draws reaches the "
-                               f"ratio {ratio}")
+    run, device, cal, device_draw = _calibrated_device(
+        scen, tb, duration_s, (rng_device, rng_excitation, rng_shape), noise_rel_acc,
+        friction_form, ratio, noise_rms)
     contribution = cal.with_effect - cal.baseline
     jac = sensitivities(run, device, cal.n_sub)
     truth = _truth(scen, seed, run, cal, contribution, jac, noise_rms, sensor, lsb, ratio)
@@ -1512,10 +1503,8 @@ def generate(name: str, seed: int, ratio: float = 0.5, duration_s: float = 40.0,
     sidecar = {"M": device.M, "m": device.m, "k": device.k}
     recording = _record(run, cal, noise, lsb, sensor_resonance)
     if sensor_resonance is not None:
-        change = recording["rel_acc"] - _record(run, cal, noise, lsb)["rel_acc"]
-        truth["sensor_resonance"] = {"f_hz": float(sensor_resonance[0]),
-                                     "zeta": float(sensor_resonance[1]),
-                                     "change_to_noise": _rms(change[tb.window]) / noise_rms}
+        truth["sensor_resonance"] = _sensor_truth(run, cal, noise, lsb, sensor_resonance,
+                                                  recording, noise_rms)
     driven = recorded_input_contribution(run, cal, recording["base_acc"].to_numpy())
     truth["input_driven_to_clean_contribution"] = (
         _rms((driven - contribution)[tb.window]) / max(_rms(contribution[tb.window]), 1e-300))
@@ -1523,6 +1512,35 @@ def generate(name: str, seed: int, ratio: float = 0.5, duration_s: float = 40.0,
     truth["shared_input_noise"] = bool(shared_input_noise)
     return GeneratedRecording(recording, sidecar, truth, contribution, cal.with_effect,
                               cal.baseline, driven)
+
+
+def _calibrated_device(scen: LiteratureScenario, tb: TimeBase, duration_s: float, rngs: tuple,
+                       noise_rel_acc: float, friction_form: str, ratio: float,
+                       noise_rms: float) -> tuple[_Run, Device, _Calibrated, int]:
+    """(run, device, calibration, draws made): devices drawn (``rngs``: the device's, the
+    excitation's and the shape's streams) until one reaches the ratio, at most
+    MAX_DEVICE_DRAWS."""
+    rng_device, rng_excitation, rng_shape = rngs
+    for device_draw in range(1, MAX_DEVICE_DRAWS + 1):
+        device = draw_device(rng_device, noise_rel_acc, friction_form)
+        run = _Run(draw_excitation(rng_excitation, device, tb.period, duration_s, tb.fs), tb)
+        device = settle_v_t(run, device)
+        try:
+            cal = _calibrate(run, scen, device, rng_shape, ratio * noise_rms, noise_rms)
+            return run, device, cal, device_draw
+        except UnreachableRatio:
+            continue
+    raise UnreachableRatio(f"{scen.name}: no device in {MAX_DEVICE_DRAWS} draws reaches the "
+                           f"ratio {ratio}")
+
+
+def _sensor_truth(run: _Run, cal: _Calibrated, noise, lsb, sensor_resonance: tuple,
+                  recording: pd.DataFrame, noise_rms: float) -> dict[str, float]:
+    """The mass accelerometer's resonance (f Hz, zeta) and its change of the recorded rel_acc
+    over the noise RMS."""
+    change = recording["rel_acc"] - _record(run, cal, noise, lsb)["rel_acc"]
+    return {"f_hz": float(sensor_resonance[0]), "zeta": float(sensor_resonance[1]),
+            "change_to_noise": _rms(change[run.tb.window]) / noise_rms}
 
 
 def missing_force_truth(run: _Run, cal: _Calibrated) -> dict[str, float]:
