@@ -1023,8 +1023,8 @@ def run_tmcmc(
     """Sample ``model`` with `TMCMC` and return InferenceData with tidy TMCMC statistics.
 
     ``kernel_kwargs`` go to `TMCMC` (``proposal_scale``, ``target_cov``, ``mcmc_steps``,
-    ``resampling``, ``reference``, ``deadline``, ``log``). ``idata.sample_stats`` is replaced by `tidy_sample_stats`:
-    ``log_evidence`` per chain, the tempering schedule ``beta`` (chain, stage), acceptance
+    ``resampling``, ``reference``, ``deadline``, ``log``). ``idata.sample_stats`` is replaced
+    by `tidy_sample_stats`: ``log_evidence`` per chain, the tempering schedule ``beta`` (chain, stage), acceptance
     rates, likelihood evaluations and wall times; numeric only, so it can be saved to netCDF.
     """
     start = time.perf_counter()

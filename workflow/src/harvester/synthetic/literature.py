@@ -45,10 +45,10 @@ mains_hum               rel_acc + A sin(2 pi 50|60 Hz t + phi)      -- (unmodell
 maxwell_slip            (1-s) F_dev + s 2 Maxwell-slip elements     hysteresis, sticking (coulomb)
 ======================  ==========================================  =========================
 
-The four after the effect-free one are outside the library (no correct name): a force periodic in the
-displacement (a generator's cogging through the screw), an even spring, a slow change (the
-friction's level drifting; a slow force itself would not show in z'', whose response to it
-falls as (f / f_n)^2), and the acquisition's own line (mains hum on the mass accelerometer's
+The four after the effect-free one are outside the library (no correct name): a force
+periodic in the displacement (a generator's cogging through the screw), an even spring, a
+slow change (the friction's level drifting; a slow force itself would not show in z'', whose
+response to it falls as (f / f_n)^2), and the acquisition's own line (mains hum on the mass accelerometer's
 channel, added to the reading before the DAQ's filter, not to the motion). Maxwell-slip, a
 friction law with memory, was added after them, so that the earlier scenarios keep their
 places in the grids.

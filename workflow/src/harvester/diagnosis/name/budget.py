@@ -5,8 +5,8 @@ The budget is a target for the whole diagnosis (by default from the recording's 
 :func:`budget_seconds`); the search for names (the rounds' screens and TMCMC runs, the second
 pass) gets what is left of it once the later steps' reserve is kept (:func:`search_seconds`).
 The baseline's own sampling is not cut, nor the fit on unseen data, the missing force and the
-figures that follow the search. Past the deadline a candidate's TMCMC stops at its next stage or move
-(``inference.tmcmc.OutOfTime``) and no further candidate, round or pass starts. A candidate
+figures that follow the search. Past the deadline a candidate's TMCMC stops at its next stage
+or move (``inference.tmcmc.OutOfTime``) and no further candidate, round or pass starts. A candidate
 stopped or not started is neither named nor rejected: diagnosis.json lists it
 (``budget.unfinished``) and the headline says the budget ran out, so that a user knows which
 decision a larger budget (``--budget``) would make.
