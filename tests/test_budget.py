@@ -113,18 +113,20 @@ def test_a_candidate_stopped_mid_run_is_reported_not_judged(record, tmp_path, mo
     assert diag.missing == [] and not any(r["accepted"] for r in doc["rounds"])
 
 
+@pytest.mark.parametrize("asked, how", [(1, "not screened"), (2, "MAP fit stopped")])
 def test_a_screen_the_budget_cuts_leaves_its_candidates_unscreened(record, tmp_path,
-                                                                  monkeypatch):
-    """The budget runs out between the round's start and its first MAP fit."""
+                                                                  monkeypatch, asked, how):
+    """The budget runs out between the round's start and its first MAP fit (asked once), or
+    within that fit, before its first simulation (asked twice: the round, the screen)."""
     import harvester.diagnosis.name.rounds as rounds
-    answers = iter([False])  # the round starts; every later question finds the budget spent
+    answers = iter([False] * asked)  # then every later question finds the budget spent
     monkeypatch.setattr(rounds, "spent", lambda settings: next(answers, True))
     monkeypatch.setattr("harvester.diagnosis.run.spent", lambda settings: True)  # no 2nd pass
     settings = DiagnosisSettings.fast(**OPTIONS, budget_s=1e6)
     diag = diagnose_recording(record, "linear", settings=settings, out_dir=tmp_path)
     doc = _document(diag, tmp_path)
     first = doc["budget"]["unfinished"][0]
-    assert (first["where"], first["how"]) == ("round 1", "not screened"), doc["budget"]
+    assert (first["where"], first["how"]) == ("round 1", how), doc["budget"]
     assert doc["rounds"][0]["screened"] == [] and diag.missing == []
 
 

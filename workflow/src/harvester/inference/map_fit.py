@@ -27,7 +27,7 @@ whose edge the model's acquisition places at its own (``signals.chain_cutoff``).
 from __future__ import annotations
 
 import logging
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -48,6 +48,10 @@ log = logging.getLogger("harvester.diagnosis")
 #: scenario generator's Table 5 device (noise 0.022); at 0.8 it was 0.003, 0.009 and 0.0045,
 #: with the noise 8 % lower.
 ANALYSIS_FRACTION = 0.8
+
+
+class FitStopped(RuntimeError):
+    """fit_map stopped by its caller's ``stop`` (a time budget) before its end: no fit."""
 
 
 @dataclass
@@ -249,7 +253,8 @@ class PriorCoordinates:
 
 
 def fit_map(problem: ChainProblem, priors: Mapping[str, PriorSpec], n_starts: int = 48,
-            seed: int = 0, start: np.ndarray | None = None, solves: int = 1) -> PointFit:
+            seed: int = 0, start: np.ndarray | None = None, solves: int = 1,
+            stop: Callable[[], bool] | None = None) -> PointFit:
     """Posterior mode of the free physical parameters, sigma profiled (sigma = RMS residual).
 
     Minimises lambda n/2 log(sum r^2) + 1/2 sum_j w_j u_j^2 over u within the priors' bounds
@@ -258,7 +263,8 @@ def fit_map(problem: ChainProblem, priors: Mapping[str, PriorSpec], n_starts: in
     started from the best ``solves`` of ``n_starts`` prior draws, the prior's centre and
     ``start`` (free physical parameters, a vector or rows of them, optional) evaluated in one
     batched simulation, keeping the best end. Jacobians by forward differences, one batched
-    simulation each.
+    simulation each. ``stop``: asked before each batched simulation; once it says so the fit
+    ends with :class:`FitStopped` (a time budget spent).
     """
     coords = PriorCoordinates.of(problem, priors)
     w = coords.penalty
@@ -266,6 +272,9 @@ def fit_map(problem: ChainProblem, priors: Mapping[str, PriorSpec], n_starts: in
     count = [0]
 
     def resid_u(us: np.ndarray) -> np.ndarray:
+        if stop is not None and stop():
+            raise FitStopped(f"{problem.structure.name}: MAP fit stopped after {count[0]} "
+                             "simulations")
         theta = np.column_stack([coords.theta(us), np.ones(len(np.atleast_2d(us)))])
         count[0] += len(theta)
         return problem.residuals(theta)

@@ -135,7 +135,8 @@ def sample_round(rnd: Round, now: Current, effects: list[str], analysis: Analysi
     rnd.screen = screen(now.fit, effects, now.priors, scale, det, settings.seed + r,
                         stop=lambda: spent(settings))
     rnd.unfinished += [Unfinished(f"round {r + 1}", now.fit.structure.with_term(e).name,
-                                  "not screened") for e in rnd.screen.unscreened]
+                                  "MAP fit stopped" if e == rnd.screen.stopped
+                                  else "not screened") for e in rnd.screen.unscreened]
     rnd.seconds["screen"] = time.perf_counter() - begun
     # the acceptance shares alpha among every candidate the round could name
     confirmation = replace(settings.confirmation(), family=len(det.candidates),

@@ -59,8 +59,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from harvester.inference.map_fit import (PILE_NATS, PointFit, PriorCoordinates, bound_pull,
-                                          chain_problem, fit_map)
+from harvester.inference.map_fit import (PILE_NATS, FitStopped, PointFit, PriorCoordinates,
+                                          bound_pull, chain_problem, fit_map)
 from harvester.diagnosis.name.fits import ModelFit, candidate_priors, scan_factor
 from harvester.diagnosis.detect.scores import EDGE_SHARE, Detection
 from harvester.inference.importance import (Component, ImportanceEstimate, MixtureProposal,
@@ -205,6 +205,7 @@ class Screen:
     nested_importance: ImportanceEstimate | None = None
     importance_check: bool = False  # that estimate agrees with the nested model's sampled one
     unscreened: list[str] = field(default_factory=list)  # not fitted: the time budget ran out
+    stopped: str | None = None  # the effect whose MAP fit the budget ended mid-way
 
     @property
     def order(self) -> list[str]:
@@ -252,8 +253,9 @@ def screen(nested: ModelFit, effects: list[str], priors: Mapping[str, PriorSpec]
            scale: DeviceScale, detection: Detection | None = None, seed: int = 0,
            stop: Callable[[], bool] | None = None) -> Screen:
     """Each effect's MAP on the nested model's data and likelihood and its bounds, sorted by
-    ``bound`` (failed fits last). ``stop``: asked before each effect's fit; once it says so
-    (the time budget is spent) the effects left are not fitted (``Screen.unscreened``)."""
+    ``bound`` (failed fits last). ``stop``: asked before each effect's fit and each of its
+    simulations; once it says so (the time budget is spent) the fit under way ends
+    (``Screen.stopped``) and the effects left are not fitted (``Screen.unscreened``)."""
     nested_mean = nested.samples.mean(axis=0)
     point = fit_map(nested.problem, nested.priors, seed=seed, start=nested_mean[:-1])
     names = nested.names
@@ -268,8 +270,14 @@ def screen(nested: ModelFit, effects: list[str], priors: Mapping[str, PriorSpec]
             out.unscreened = list(effects[i:])
             log.info("not screened, the time budget is spent: %s", ", ".join(out.unscreened))
             break
-        out.candidates.append(_screen_one(nested, effect, priors, scale, detection, seed,
-                                          nested_mean, out))
+        try:
+            out.candidates.append(_screen_one(nested, effect, priors, scale, detection, seed,
+                                              nested_mean, out, stop))
+        except FitStopped:
+            out.unscreened, out.stopped = list(effects[i:]), effect
+            log.info("%s: its MAP fit stopped, the time budget is spent; not screened: %s",
+                     effect, ", ".join(out.unscreened))
+            break
     out.candidates.sort(key=lambda s: (s.failed, -s.bound))
     log.info("screened by MAP (nested: log evidence %.1f, best log L %.1f, Laplace %.1f): %s",
              nested.log_evidence, out.nested_loglike, out.nested_laplace, "; ".join(
@@ -359,16 +367,17 @@ def _usable(c: Component) -> bool:
 
 def _screen_one(nested: ModelFit, effect: str, priors: Mapping[str, PriorSpec],
                 scale: DeviceScale, detection: Detection | None, seed: int,
-                nested_mean: np.ndarray, so_far: Screen) -> Screened:
+                nested_mean: np.ndarray, so_far: Screen,
+                stop: Callable[[], bool] | None = None) -> Screened:
     """One candidate's MAP and bounds against the nested model (``so_far``: its best
-    likelihood and Laplace evidence)."""
+    likelihood and Laplace evidence); ``stop`` ends its MAP fit (:class:`FitStopped`)."""
     clock = time.perf_counter()
     p = nested.problem
     problem = chain_problem(p, p.temper, p.lowpass_hz, p.filter_order,
                             structure=nested.structure.with_term(effect))
     specs = {**candidate_priors(effect, scale, p.known), **priors}
     starts = _starts(problem, specs, nested, nested_mean, effect, detection, seed)
-    fit = fit_map(problem, specs, seed=seed, start=starts, solves=MAP_SOLVES)
+    fit = fit_map(problem, specs, seed=seed, start=starts, solves=MAP_SOLVES, stop=stop)
     ll, value = fit_value(problem, fit.theta, {**specs, **nested.priors}, nested.names)
     gain = value - so_far.nested_value
     out = Screened(effect, problem.parameter_names, fit.theta, ll, gain + GAIN_SLACK,
