@@ -99,7 +99,8 @@ def test_a_candidate_whose_device_contradicts_the_sidecar_is_not_accepted() -> N
         return SimpleNamespace(log_evidence=log_evidence, log_evidence_se=0.05,
                                names=list(s.free_parameters) + ["sigma"], priors=priors,
                                samples=samples, structure=s,
-                               problem=SimpleNamespace(known=known))
+                               problem=SimpleNamespace(known=known, input_type=SimpleNamespace(
+                                   force_input=False)))
 
     base, cs = fit(0.0, draws), ConfirmSettings()
     wild = judge("inertia_error", fit(50.0, draws), base, cs)
@@ -224,3 +225,21 @@ def test_a_refused_mass_error_is_said_in_the_headline_and_the_notes() -> None:
     judged = judge(found, detection, _fit(1.5), "tanh", DiagnosisSettings())
     assert judged.verdict == "missing_physics"
     assert "not named: inertia_error: the record's mismatch pulls" in judged.headline
+
+
+def test_a_mass_error_is_no_candidate_where_the_baseline_identifies_the_masses() -> None:
+    """A mass error only restates M (and, with a base input, m) where none is given: it is
+    left out of the candidates, with a note; a stated mass keeps it (EMPS through the command
+    line, M from its FRF, had named dM = +135 kg)."""
+    from harvester.diagnosis import DiagnosisSettings
+    from harvester.diagnosis.prepare.redundant import redundant_terms, without_redundant
+
+    assert set(redundant_terms({}, force_input=True)) == {"inertia_error"}
+    assert redundant_terms({"M": 95.0}, force_input=True) == {}
+    assert set(redundant_terms({"k": 1e3}, force_input=False)) == {"inertia_error"}
+    assert redundant_terms({"m": 3.0}, force_input=False) == {}  # m is stated: a payload error
+    settings, notes = without_redundant(DiagnosisSettings(), {"m": 0.0}, force_input=True)
+    assert "inertia_error" not in settings.candidates and "cubic_stiffness" in settings.candidates
+    assert len(notes) == 1 and "restate M" in notes[0] and "give M" in notes[0]
+    chosen = DiagnosisSettings(candidates=("cubic_stiffness",))
+    assert without_redundant(chosen, {}, force_input=True) == (chosen, [])

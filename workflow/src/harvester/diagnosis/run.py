@@ -39,6 +39,7 @@ from harvester.diagnosis.name.verdict import (Conclusion, FitJudgement, Tie, con
 from harvester.diagnosis.prepare.analysis import (Analysis, BaselineStart, check_recording,
                                                   default_priors, prepare, resample_for_model,
                                                   start_baseline, velocity_bound)
+from harvester.diagnosis.prepare.redundant import without_redundant
 from harvester.diagnosis.prepare.recording import DiagnosisInput, diagnosis_input
 from harvester.diagnosis.prepare.settings import DiagnosisSettings
 from harvester.diagnosis.report.document import UnseenFit
@@ -124,6 +125,11 @@ def diagnose(recording: pd.DataFrame, baseline: str | ModelStructure,
         timeline.steps.append(("input", max(time.time() - started, 0.0)))
     with timeline.step("prepare"):
         analysis = prepare(recording, validation, baseline, known, settings, source)
+    settings, dropped = without_redundant(settings, analysis.known,
+                                          analysis.detection_raw.input_type.force_input)
+    for note in dropped:
+        log.info("%s", note)
+    analysis.notes.extend(dropped)
     with timeline.step("baseline"):
         start = start_baseline(analysis, priors, posterior, settings)
     passes = _pass(analysis, start, settings, timeline=timeline)

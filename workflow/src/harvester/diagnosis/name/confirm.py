@@ -63,6 +63,7 @@ from harvester.diagnosis.name.fits import (BRIDGE_MIN_SE, MISSED_MODE_NATS, Mode
 from harvester.diagnosis.name.budget import OutOfTime, Unfinished, spent
 from harvester.diagnosis.name.screen import Screen
 from harvester.data.sidecar import DEFAULT_RELATIVE_SD
+from harvester.diagnosis.prepare.redundant import used_quantities
 from harvester.diagnosis.name.plausibility import (Implied, contradictions, implied_device,
                                               measured_device)
 from harvester.diagnosis.detect.signatures import candidate_terms
@@ -116,6 +117,9 @@ class ConfirmSettings(TMCMCSettings):
 
     noise_floor: the recording's own noise floor (output units, ``detect.floor``; None where
     none is measured): a term's displacement below it (:func:`unresolved`) is not named.
+
+    candidates: the library terms the diagnosis may try (None: all), also where a candidate
+    stands for another at a bound (:func:`limit_candidates`).
     """
 
     particles: int = 300
@@ -132,6 +136,7 @@ class ConfirmSettings(TMCMCSettings):
     device_sd: tuple[tuple[str, float], ...] = ()
     device_relative_sd: float = DEFAULT_RELATIVE_SD
     noise_floor: float | None = None
+    candidates: tuple[str, ...] | None = None
 
     def tmcmc(self, offset: int = 0) -> TMCMCSettings:
         """The sampler's settings alone, the seed moved by ``offset``."""
@@ -448,7 +453,7 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
             reason = BUDGET_REASON
         if reason is not None:
             order[i + 1:i + 1] = _skip(screened, effect, reason, effect in pulled,
-                                       baseline.structure, order)
+                                       baseline.structure, order, settings.candidates)
             if late and reason == BUDGET_REASON:
                 cut.append(Unfinished(where, baseline.structure.with_term(effect).name,
                                       "not sampled"))
@@ -472,7 +477,7 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
         if screened is not None:
             screened.sampled = True
         order[i + 1:i + 1] = limit_candidates(effect, results[-1].at_limit,
-                                              baseline.structure, order)
+                                              baseline.structure, order, settings.candidates)
     results.sort(key=lambda r: -r.delta_log_evidence)
     mark_ties(results, settings)
     return results
@@ -483,14 +488,14 @@ BUDGET_REASON = "the time budget ran out before it"
 
 
 def _skip(screened, effect: str, reason: str, pulled: bool, structure: ModelStructure,
-          order: list[str]) -> list[str]:
+          order: list[str], allowed: tuple[str, ...] | None = None) -> list[str]:
     """Say why ``effect`` is not sampled; the terms it stands for at the bound its best fit
-    lies on (where it is ``pulled``), to sample next in its place."""
+    lies on (where it is ``pulled``), to sample next in its place (of ``allowed``)."""
     _skipped(screened, effect, reason)
     if not pulled:
         return []
     edges = {n: side for n, (side, _) in screened.pulled.items()}
-    return limit_candidates(effect, edges, structure, order)
+    return limit_candidates(effect, edges, structure, order, allowed)
 
 
 def _skipped(screened, effect: str, reason: str) -> None:
@@ -603,11 +608,12 @@ def sampling_order(order: list[str], fitted: Mapping) -> tuple[list[str], set[st
 
 
 def limit_candidates(effect: str, edges: Mapping[str, str], structure: ModelStructure,
-                     order: list[str]) -> list[str]:
+                     order: list[str], candidates: tuple[str, ...] | None = None) -> list[str]:
     """The terms a candidate stands for where its posterior piled, or its best fit lies,
     against a bound (``edges``: name -> side; ``Term.limits``), that the structure can take
-    and the round has not listed: sampled next, in its place (unscreened, so always)."""
-    allowed = set(candidate_terms(structure.terms))
+    (of ``candidates``, None: any) and the round has not listed: sampled next, in its place
+    (unscreened, so always)."""
+    allowed = set(candidate_terms(structure.terms, candidates))
     out = []
     for name, side in edges.items():
         other = next((o for o in term(effect).limit_terms(name, side) if o in allowed), None)
@@ -778,12 +784,15 @@ def unresolved(effect: str, fit: ModelFit, noise_floor: float | None
 def candidate_device(effect: str, fit: ModelFit, settings: ConfirmSettings) -> list[Implied]:
     """The stated device quantities (the fit's known M, m, k, with ``settings``'
     uncertainties) that ``effect``'s posterior implies (``plausibility``); none where its
-    term declares none."""
+    term declares none. Only those the recording's model uses: with a force input m is a
+    placeholder, not a stated mass (``redundant.used_quantities``)."""
     if term(effect).device is None:
         return []
     known = fit.problem.known
-    return implied_device(effect, fit.structure, fit.samples, known, measured_device(
-        known, settings.device_sd, settings.device_relative_sd))
+    used = used_quantities(fit.problem.input_type.force_input)
+    stated = measured_device(known, settings.device_sd, settings.device_relative_sd)
+    return implied_device(effect, fit.structure, fit.samples, known,
+                          {n: v for n, v in stated.items() if n in used})
 
 
 def becomes(result: CandidateResult, effect: str) -> bool:

@@ -5,6 +5,8 @@
                  low-pass, the validation record, the friction's contact, the priors from the
                  recording (the one place for the command line and Python alike)
 ``topology``     what the friction acts on when the sidecar does not say (base or ground)
+``redundant``    the candidates that would only restate what the baseline identifies (a mass
+                 error where no mass is given)
 ``analysis``     the recording cut into windows for the model, and the baseline's posterior the
                  rounds start from
 """

@@ -162,4 +162,4 @@ class DiagnosisSettings:
                                enlargements=self.enlargements, alpha=self.evidence_alpha,
                                reference=self.reference_start, device_sd=self.device_sd,
                                device_relative_sd=self.device_relative_sd,
-                               deadline=self.deadline)
+                               deadline=self.deadline, candidates=self.candidates)

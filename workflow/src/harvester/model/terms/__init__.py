@@ -164,6 +164,10 @@ class Term:
     parameter's value (a mapping; arrays over posterior draws) returning {quantity: value}:
     an inertia error's M + dM and m + m_share dM. The diagnosis holds them against the
     sidecar (``diagnosis.name.plausibility``); None: the term implies none of them.
+    ``restates``: device quantities (of :data:`DEVICE_QUANTITIES`) that the term only
+    restates (a mass error: M and m): where the baseline identifies every one of them the
+    recording depends on (none given), the term adds no physics, its gain being those
+    quantities' prior conflict, and it is not a candidate (``diagnosis.prepare.redundant``).
     ``resolved``: parameters that are displacements (m) the record must resolve for the term
     to be its physics (a pre-sliding displacement): where the posterior puts one below the
     smallest displacement the record tells from its noise, the term is taken at that
@@ -194,6 +198,7 @@ class Term:
     alike: tuple[str, ...] = ()
     limits: tuple[tuple[str, str, str], ...] = ()
     resolved: tuple[str, ...] = ()
+    restates: tuple[str, ...] = ()
     nameable: bool = True
     device: Callable[[Mapping], dict] | None = None
     source: str = field(default="", compare=False)  # the file that defines the term
