@@ -125,13 +125,13 @@ def test_a_reading_without_a_resonance_rules_the_sensor_out(device, monkeypatch)
     truth, noise = device
     output = lowpass(truth["a"] + noise, FS, LOWPASS_HZ, 8)
     state = baseline_state(chain(truth, "linear", output), np.array([[C_M, 0.05]]))
-    monkeypatch.setattr(sensor, "fit_sensor", lambda st, f: (30.0, 0.25, "the output's sensor",
+    monkeypatch.setattr(sensor, "fit_sensor", lambda st, f: (15.0, 0.25, "the output's sensor",
                                                              60.0))
     monkeypatch.setattr(sensor, "device_gain", lambda st, p, th: 40.0)
     reading = sensor.read_resonance(state, "hysteresis", None, None, LOWPASS_HZ,
                                     ConfirmSettings())
     assert reading.conclusion == "device" and "no resonance" in reading.sentence()
-    monkeypatch.setattr(sensor, "fit_sensor", lambda st, f: (30.0, 0.05, "the output's sensor",
+    monkeypatch.setattr(sensor, "fit_sensor", lambda st, f: (15.0, 0.05, "the output's sensor",
                                                              60.0))
     assert sensor.read_resonance(state, "hysteresis", None, None, LOWPASS_HZ,
                                  ConfirmSettings()).conclusion == "sensor"
