@@ -24,7 +24,8 @@ prime factors 2, 2, 5 of 20 (the example's ``decimate(y, r, 'fir')``; here
 one period more simulated than kept, so that the filter's end effect is cut away. Output
 noise: white Gaussian, standard deviation 8e-3 mm (:data:`NOISE_SD_M`, the benchmark's
 level as its ports use it: deepSI's ``Bouc_wen`` system, github.com/GerbenBeintema/deepSI,
-``deepSI/systems/boucwen.py``, 8e-6 m). The benchmark's parameters and signal design were
+``deepSI/systems/boucwen.py``, 8e-6 m, which it also low-passes; white here, band-limited
+by the 750 Hz sampling alone). The benchmark's parameters and signal design were
 read in those public copies (the example script, deepSI); the nonlinear-benchmark Python
 package (github.com/GerbenBeintema/nonlinear_benchmarks) loads only the benchmark's test
 signals and has no simulator.
