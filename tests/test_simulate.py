@@ -125,6 +125,7 @@ TERM_PARAMS = {
     "end_stop": [0.01, 5000.0],
     "backlash": [1e-5, 1e7],
     "hysteresis": [2.0, 1e-4, 50.0],
+    "hysteretic_spring": [125.0, 0.005, -1.375],
     "unmodelled_mode": [6.0, 0.05, 0.5, 1.0],
     "inertia_error": [0.8, 0.5],
     "offset_force": [3.0],

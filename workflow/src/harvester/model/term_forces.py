@@ -3,8 +3,9 @@ left-hand side of eq. (1) with the stated masses M and m:
 
     M z'' + c_m z' + k z + sum_T X_T = drive,     drive = -m y'' (base input) or F (force).
 
-``screw``    X = force(z', h...; params), internal states h advanced along the path
-             (``displacement_update`` where the term has one, else its ``state_rates``)
+``screw``    X = force(z', h...; params), internal states h (one or two) advanced along the
+             path from 0 (``displacement_update`` where the term has one, else its
+             ``state_rates``)
 ``mass``     X = force(z; params)
 ``inertia``  (M, m) -> (M', m') = masses(M, m; params): X = (M' - M) z'' + (m' - m) y''
 ``mode``     states (u, u') driven by the path's z'' and y'' (RK4 with the acceleration
@@ -34,7 +35,7 @@ from harvester.model.terms import Term
 #: and a compiled law's type differs in every process, so Numba's cache never found an entry,
 #: added one per process (121 in a working copy) and at times failed to write its index
 #: ("underlying object has vanished"). They compile once per process instead.
-NOT_CACHED = ("_stateless", "_with_update", "_with_rates", "_mode")
+NOT_CACHED = ("_stateless", "_with_update", "_with_rates", "_with_two_rates", "_mode")
 
 #: Fewest sub-steps per sample for a mode's states, and its largest omega_n h.
 MODE_SUBSTEPS, MODE_RATE_H = 4, 0.3
@@ -80,6 +81,26 @@ def _with_rates(force, rates, v, dt, n_sub, params):
                     k2 = rates(w1, h + hs * k1, *params)
                     h = h + 0.5 * hs * (k1 + k2)
             out[i, k] = force(v[i, k], h, *params)
+    return out
+
+
+@nb.njit(cache=False)  # takes compiled laws: see NOT_CACHED
+def _with_two_rates(force, rates, v, dt, n_sub, params):
+    """A screw term with two states (h, g)' = rates(w, h, g), as :func:`_with_rates`."""
+    out = np.empty_like(v)
+    hs = dt / n_sub
+    for i in range(v.shape[0]):
+        h, g = 0.0, 0.0
+        for k in range(v.shape[1]):
+            if k > 0:
+                for s in range(n_sub):
+                    w0 = v[i, k - 1] + (v[i, k] - v[i, k - 1]) * s / n_sub
+                    w1 = v[i, k - 1] + (v[i, k] - v[i, k - 1]) * (s + 1) / n_sub
+                    k1 = rates(w0, h, g, *params)
+                    k2 = rates(w1, h + hs * k1[0], g + hs * k1[1], *params)
+                    h = h + 0.5 * hs * (k1[0] + k2[0])
+                    g = g + 0.5 * hs * (k1[1] + k2[1])
+            out[i, k] = force(v[i, k], h, g, *params)
     return out
 
 
@@ -132,6 +153,9 @@ def term_force(t: Term, values: Mapping[str, float], z: np.ndarray, v: np.ndarra
     if t.kind == "screw" and t.n_states == 1:
         return _with_rates(compiled(t.name, "force"), compiled(t.name, "state_rates"), v, dt,
                            16, params)
+    if t.kind == "screw" and t.n_states == 2:
+        return _with_two_rates(compiled(t.name, "force"), compiled(t.name, "state_rates"), v,
+                               dt, 16, params)
     if t.kind == "stick":  # sliding: sgn(z') times its magnitude; stuck (z' = 0): 0 here
         return np.sign(v) * _stateless(compiled(t.name, "force"), np.abs(v), params)
     if t.kind == "inertia":

@@ -717,12 +717,14 @@ def library_terms(shape: str) -> tuple[str, ...]:
     """The library's terms whose force has ``shape`` (a shape's name); none for a shape
     outside the library. Friction on the ground is the same term acting on the mass's own
     velocity (``topology``). Stick and slip is the shape of the friction laws that hold
-    (``STICKING_FRICTION`` and their refinements), a smooth law's force creeps instead."""
+    (``STICKING_FRICTION`` and their refinements), a smooth law's force creeps instead. A
+    loop is also the shape of a hysteretic spring's departure from its linear part."""
     friction = tuple(name for name, t in TERMS.items() if is_friction(t))
     sticking = tuple(name for name, t in TERMS.items() if name in STICKING_FRICTION
                      or set(t.refines) & set(STICKING_FRICTION))
     return {"odd in z": ("cubic_stiffness", "end_stop"), "damping": ("quadratic_damping",),
-            "friction": friction, "loop": friction, "friction on the ground": friction,
+            "friction": friction, "loop": friction + ("hysteretic_spring",),
+            "friction on the ground": friction,
             "loop on the ground": friction, "stick-slip on the ground": sticking,
             "inertial": ("inertia_error",)}.get(shape, ())
 
