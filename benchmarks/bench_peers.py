@@ -5,6 +5,7 @@ seconds per record (``harvester.grid.peers``).
     python benchmarks/bench_peers.py --set DIR [--skip-diagnosis] [--no-narx] [--csv OUT]
     python benchmarks/bench_peers.py --make DIR [--effects duffing ...] [--free-seeds 0 1]
     python benchmarks/bench_peers.py --make DIR --real [--fast] [--jobs 2] --set DIR
+    python benchmarks/bench_peers.py --make DIR --kinds "base_disp->rel_disp" --duration 20
 
 ``--set DIR``: any folder of acceleration recordings (``<name>.csv`` with its sidecar
 ``<name>.yaml``) each with a truth ``<name>.json`` (``correct_names``, ``ratio``; as the
@@ -19,7 +20,8 @@ thresholds, SysIdentPy's polynomial NARX free run. pysindy and sysidentpy: ``pip
 ``--make DIR``: writes literature-grid records into DIR as the grid makes them
 (config/config.yaml: 40 s at 256 Hz, ratio 0.5, the grid's seed offset): each of
 ``--effects`` at seed 0 and the effect-free record at each of ``--free-seeds``
-(``--effects`` with no name: none). ``--real``: the shipped real recordings too (the frame at
+(``--effects`` with no name: none), of each of ``--kinds`` (the generator's recording kinds,
+``literature.KINDS``; default base_acc->rel_acc), ``--duration`` s each. ``--real``: the shipped real recordings too (the frame at
 250 g and 450 g, the Silverbox; ``grid.recorded``: their truths and why), read from
 ``--data`` (default data/public); their diagnosis is ``diagnosis.diagnose_recording``, the
 command line's call on the file, against the study's linear baseline.
@@ -48,22 +50,36 @@ EFFECTS = ("duffing", "quadratic_damping", "stribeck_exponential", "end_stop_her
 DATA = ROOT / "data" / "public"
 
 
-def make_set(out: Path, effects, free_seeds) -> None:
-    """The grid's records (and truths, sidecars) of ``effects`` and effect-free seeds."""
+#: File-name tags of the literature generator's recording kinds (the default's: none).
+KIND_TAGS = {"base_acc->rel_acc": "", "base_disp->rel_disp": "_dd", "base_disp->rel_acc": "_da",
+             "force->rel_disp": "_fd"}
+
+
+def make_set(out: Path, effects, free_seeds, kinds=("base_acc->rel_acc",),
+             duration_s: float | None = None) -> None:
+    """The grid's records (and truths, sidecars) of ``effects`` and effect-free seeds, of
+    each recording kind of ``kinds`` (``<effect><tag>_s<seed>``, :data:`KIND_TAGS`), lasting
+    ``duration_s`` (None: the grid's). A scenario a kind cannot express (friction on the
+    ground with a force input) is skipped with a line saying why."""
     from harvester.grid.generators import make_scenario_files
     cfg = yaml.safe_load(CONFIG.read_text())
     det, grid = cfg["detection"], cfg["detection"]["grids"]["literature"]
-    settings = {"duration_s": float(grid["duration_s"]), "lead_in_s": float(det["lead_in_s"]),
-                "seed": int(det["seed"])}
+    settings = {"duration_s": float(duration_s or grid["duration_s"]),
+                "lead_in_s": float(det["lead_in_s"]), "seed": int(det["seed"])}
     out.mkdir(parents=True, exist_ok=True)
-    jobs = [(e, float(grid["ratios"][0]), 0) for e in effects] + \
-        [("none", 0.0, s) for s in free_seeds]
-    for effect, ratio, seed in jobs:
-        csv = out / f"{effect}_s{seed}.csv"
+    jobs = [(e, float(grid["ratios"][0]), 0, k) for k in kinds for e in effects] + \
+        [("none", 0.0, s, k) for k in kinds for s in free_seeds]
+    for effect, ratio, seed, kind in jobs:
+        csv = out / f"{effect}{KIND_TAGS[kind]}_s{seed}.csv"
         if csv.is_file():
             continue
-        truth = make_scenario_files("literature", effect, ratio, seed, settings, cfg["rig"],
-                                    cfg["preprocess"], csv, csv.with_suffix(".json"))
+        try:
+            truth = make_scenario_files("literature", effect, ratio, seed,
+                                        {**settings, "kind": kind}, cfg["rig"],
+                                        cfg["preprocess"], csv, csv.with_suffix(".json"))
+        except ValueError as err:
+            print(f"skipped {csv.name}: {err}", flush=True)
+            continue
         csv.with_suffix(".yaml").write_text("".join(f"{k}: {float(v)!r}\n"
                                                     for k, v in truth["known"].items()))
         print(f"made {csv.name}", flush=True)
@@ -135,6 +151,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--make", type=Path, help="write literature-grid records into this folder")
     p.add_argument("--effects", nargs="*", default=list(EFFECTS))
     p.add_argument("--free-seeds", nargs="*", type=int, default=[0, 1])
+    p.add_argument("--kinds", nargs="*", default=["base_acc->rel_acc"],
+                   help="with --make: the literature generator's recording kinds")
+    p.add_argument("--duration", type=float, help="with --make: seconds per record "
+                   "(default: the grid's)")
     p.add_argument("--skip-diagnosis", action="store_true", help="the peers only")
     p.add_argument("--kept-only", action="store_true",
                    help="the diagnosis only where a <name>.diagnosis.json is kept (none run)")
@@ -148,7 +168,7 @@ def main(argv: list[str] | None = None) -> int:
     args = p.parse_args(argv)
     clock = time.perf_counter()
     if args.make:
-        make_set(args.make, args.effects, args.free_seeds)
+        make_set(args.make, args.effects, args.free_seeds, args.kinds, args.duration)
         if args.real:
             from harvester.grid.recorded import write_recorded_set
             for csv in write_recorded_set(args.data, args.make):
