@@ -6,6 +6,16 @@ acquisition come from the published models cited per scenario, so that a diagnos
 it is tested on physics it was not written from. ``generate(name, seed)`` returns the
 recording (``time, base_acc, rel_acc``), its sidecar (the "known" M, m, k) and the truth.
 
+Recording kinds (``kind``, :data:`KINDS`; the same device, excitation and effect per seed):
+``base_acc->rel_acc`` (default) the two accelerometers below; ``base_disp->rel_disp`` the
+base displacement y (y'' integrated twice, with the constant base velocity that leaves y no
+straight-line trend) and the relative displacement z; ``base_disp->rel_acc`` y and z'';
+``force->rel_disp`` the base fixed and the force F = -m y'' on the mass (eq. 1 is then driven
+by F, the motion the same), z (to ground). Their channels each carry their own white noise
+through the DAQ, sized by what the model takes of the channel (y'' of a base displacement,
+z' of a relative one: :data:`NOISE_SHARES`); the strength's ratio is to the realised noise
+RMS of the recorded output.
+
 Device (:func:`draw_device`, per seed): eq. (1) of Green et al. (2015), a base-excited
 oscillator ``M z'' + c z' + k z + F_c S(z'/v_t) = -m y''``, z = x - y, M the effective mass
 (m plus the rotor's reflected inertia); f_n 0.5-8 Hz, M 0.5-20 kg, m/M 0.3-0.95, zeta
@@ -43,7 +53,20 @@ quadratic_spring        k2 z^2 (a spring stiffer on one side)       -- (offset_f
 friction_drift          F_dev (1 + s (t - T/2) / T), T the record   -- (none)
 mains_hum               rel_acc + A sin(2 pi 50|60 Hz t + phi)      -- (unmodelled_mode)
 maxwell_slip            (1-s) F_dev + s 2 Maxwell-slip elements     hysteresis, sticking (coulomb)
+spring_dead_zone        k dz(z, g) in place of k z, g = s z_max     -- (end_stop, backlash)
+backlash                2 DOF: m, J = M - m through a play +-g      backlash (mode, end_stop)
+ground_friction         (1-s) F_dev + s F_c S((z' + y')/v_t)        coulomb* (sticking, ...)
 ======================  ==========================================  =========================
+
+The last three were added after Maxwell-slip (issue 63). A dead zone in the main spring
+(Nordin and Gutman 2002) has no library term: end_stop adds a stiffness beyond a gap (it would
+need the spring removed), backlash couples the mass to the screw side. Backlash: the mass m
+carries the spring, the screw side J = M - m the damping and friction, coupled through a
+Kelvin-Voigt contact beyond +-g. Friction on the ground (a contact fixed to the frame, as in
+Marino and Cicirello 2023) moves a share s to the mass's absolute velocity; the sidecar is
+silent about ``friction_on``. *A friction name is right only where the diagnosis also takes
+the topology "ground" (base_disp inputs); with a force input the base is the ground and the
+form is the baseline itself (refused), with base_acc y' is the band-limited integral of y''.
 
 The four after the effect-free one are outside the library (no correct name): a force
 periodic in the displacement (a generator's cogging through the screw), an even spring, a
@@ -299,8 +322,9 @@ def _rhs(kind, p, x, yb, dx):
     """d(state)/dt into dx for base acceleration yb (m/s^2); returns z'' (m/s^2).
 
     State: z, z', then the effect's: memory variable (kept by :func:`_relax`), or the second
-    body's displacement and velocity; x[4] holds the last impact velocity of a stop, or the
-    time for a drifting friction (started at p[_VREF] = 0).
+    body's displacement and velocity; x[4] holds the last impact velocity of a stop, the
+    time for a drifting friction (started at p[_VREF] = 0), or the base velocity y' for
+    friction on the ground (started at p[_VREF] = y'(0), :attr:`_Run.base_motion`).
     """
     if kind == MOUNT:
         return _rhs_mount(p, x, yb, dx)
@@ -1514,12 +1538,14 @@ def _atomic_write(path: Path, text: str) -> None:
 class GeneratedRecording:
     """A recording, its sidecar (the 'known' M, m, k) and its ground truth."""
 
-    recording: pd.DataFrame        # time (s), base_acc, rel_acc (m/s^2)
+    recording: pd.DataFrame        # time (s), input, output (base_acc, rel_acc by default)
     sidecar: dict[str, float]      # M (kg), m (kg), k (N/m) as weighed/measured
     truth: dict[str, Any]          # JSON-serialisable
-    contribution: np.ndarray = field(repr=False)      # c(t) (m/s^2), output rate
-    clean_rel_acc: np.ndarray = field(repr=False)     # noise-free rel_acc with the effect
-    baseline_rel_acc: np.ndarray = field(repr=False)  # noise-free rel_acc of the device
+    #: c(t), noise-free outputs with the effect and of the device, at the output rate, in the
+    #: output's unit (rel_acc m/s^2 or rel_disp m: the kind's output; names kept)
+    contribution: np.ndarray = field(repr=False)
+    clean_rel_acc: np.ndarray = field(repr=False)
+    baseline_rel_acc: np.ndarray = field(repr=False)
     #: the contribution as a model driven by the recorded base_acc produces it
     #: (:func:`recorded_input_contribution`)
     input_contribution: np.ndarray = field(repr=False)
@@ -1575,12 +1601,15 @@ def _record(run: _Run, cal: _Calibrated, noise: tuple[np.ndarray, np.ndarray],
 #: Recording kinds, "input->output" (column names of ``harvester.data.recording``); the first,
 #: the paper's base-excited accelerometer pair, is the default.
 KINDS = ("base_acc->rel_acc", "base_disp->rel_disp", "base_disp->rel_acc", "force->rel_disp")
-#: Each channel's noise RMS in the kinds after the first, as a share of that channel's
-#: noise-free RMS over the baseline device (after the lead-in), set so that what the diagnosis
-#: derives from a displacement (y'' = (2 pi f)^2 y from base_disp, z' from rel_disp) is about
-#: as noisy as the accelerometer pair's channels (rel_acc noise 5-40 % of its RMS at seed 0
-#: for karnopp, maxwell_slip and none); ``generate``'s ``noise_scale`` multiplies them.
-NOISE_SHARES = {"base_disp": 5e-5, "rel_disp": 1e-3, "rel_acc": 0.05, "force": 0.05}
+#: Each channel's noise in the kinds after the first: its RMS in what the model takes of the
+#: channel (:data:`NOISE_ORDER`: y'' of base_disp, z' of rel_disp, the others as they are;
+#: derivatives spectral, up to PASSBAND x fs) as a share of that quantity's noise-free RMS
+#: (the output's over the baseline device), after the lead-in; the accelerometer pair's rel_acc
+#: noise was 5-40 % of its RMS at seed 0 (karnopp, maxwell_slip, none). ``generate``'s
+#: ``noise_scale`` multiplies them.
+NOISE_SHARES = {"base_disp": 0.05, "rel_disp": 0.05, "rel_acc": 0.05, "force": 0.05}
+#: Time derivatives of a channel its noise share is stated in.
+NOISE_ORDER = {"base_disp": 2, "rel_disp": 1, "rel_acc": 0, "force": 0}
 
 
 def generate(name: str, seed: int, ratio: float = 0.5, duration_s: float = 40.0,
@@ -1673,7 +1702,8 @@ def _generate_kind(scen: LiteratureScenario, seed: int, ratio: float, duration_s
 
     def noise_of(run: _Run, device: Device) -> float:  # the output's realised noise RMS
         base = run.output(NONE, device.params(), _initial_substeps(device, tb))
-        return share[1] * _rms(base[tb.window]) * _rms(unit[1][tb.window])
+        return _noise_scale(base, unit[1], NOISE_ORDER[out], share[1], tb) * _rms(
+            unit[1][tb.window])
 
     run, device, cal, device_draw = _calibrated_device(
         scen, tb, duration_s, rngs[:3], noise_rel_acc, friction_form, ratio, noise_of,
@@ -1704,23 +1734,51 @@ def _kind_recording(run: _Run, cal: _Calibrated, kind: str, unit: tuple, share: 
     (:attr:`_Run.base_motion`) or, with the base fixed, the force -m y'' on the mass (eq. 1
     driven by F = -m y'' moves the mass as the base acceleration y'' does); output: z'' or z.
     Each channel through the DAQ plus its own noise (``unit``, unit RMS, scaled: the input's
-    to ``share`` x its noise-free RMS, the output's by ``out_scale``). The base displacement
-    is y, not a derivative of it, so its noise is the sensor's own (the diagnosis's y'' has
-    it amplified by (2 pi f)^2)."""
+    by :func:`_noise_scale` at ``share``, the output's by ``out_scale``)."""
     tb = run.tb
     _, acc, z, _ = run.output(cal.kind, cal.p, cal.n_sub, internal=True)
     inp, out = kind.split("->")
-    clean = daq(-cal.p[_MOSC] * run.base_internal() if inp == "force" else run.base_motion[1],
-                tb.n_out)
-    in_scale = share * _rms(clean[tb.window])
+    clean = (daq(-cal.p[_MOSC] * run.base_internal(), tb.n_out) if inp == "force"
+             else _daq_moving(run.base_motion, tb))
+    in_scale = _noise_scale(clean, unit[0], NOISE_ORDER[inp], share, tb)
     recorded_in = clean + in_scale * unit[0]
     recorded_out = daq(acc if out == "rel_acc" else z, tb.n_out) + out_scale * unit[1]
     frame = pd.DataFrame({"time": np.arange(tb.n_out) / tb.fs, inp: recorded_in,
                           out: recorded_out})
     return frame, {"noise_rms_input": in_scale * _rms(unit[0][tb.window]),
                    "noise_relative_to": (
-                       "each channel's noise-free RMS after the lead-in (the output's over the "
-                       "baseline device), white through the DAQ's filter, independent")}
+                       "per channel, the noise-free RMS of what the model takes of it (y'' of "
+                       "base_disp, z' of rel_disp, the others as they are; the output's over "
+                       "the baseline device) after the lead-in; white through the DAQ's "
+                       "filter, independent")}
+
+
+def _spectral_rms(x: np.ndarray, order: int, tb: TimeBase) -> float:
+    """RMS after the lead-in (and before the last LEAD_IN_S) of the order-th derivative of x
+    (output rate; its end-to-end line removed, (i 2 pi f)^order up to PASSBAND x fs)."""
+    if order == 0:
+        return _rms(x[tb.window])
+    r = x - np.linspace(x[0], x[-1], x.size)
+    f = np.fft.rfftfreq(x.size, 1.0 / tb.fs)
+    d = np.fft.irfft(np.fft.rfft(r) * (2j * np.pi * f) ** order * (f <= PASSBAND * tb.fs),
+                     x.size)
+    return _rms(d[tb.window.start: x.size - tb.window.start])
+
+
+def _noise_scale(clean: np.ndarray, unit: np.ndarray, order: int, share: float,
+                 tb: TimeBase) -> float:
+    """The factor on ``unit`` noise that makes its order-th derivative's RMS ``share`` x the
+    clean channel's (:func:`_spectral_rms`)."""
+    return share * _spectral_rms(clean, order, tb) / _spectral_rms(unit, order, tb)
+
+
+def _daq_moving(base_motion: tuple[np.ndarray, np.ndarray], tb: TimeBase) -> np.ndarray:
+    """The base displacement y through the DAQ, the base having moved at its constant
+    starting velocity before t = 0 (not resting at 0, which :func:`daq` assumes: a step):
+    the line y(0) + y'(0) t passes the linear-phase, unit-gain filter unchanged."""
+    v, y = base_motion
+    line = y[0] + v[0] * tb.h_int * np.arange(y.size)
+    return daq(y - line, tb.n_out) + y[0] + v[0] * np.arange(tb.n_out) / tb.fs
 
 
 def _calibrated_device(scen: LiteratureScenario, tb: TimeBase, duration_s: float, rngs: tuple,
