@@ -16,6 +16,8 @@ thresholds, SysIdentPy's polynomial NARX free run. pysindy and sysidentpy: ``pip
 -e .[peers]``.
 
 ``--kept-only``: the diagnosis's rows only for records whose diagnosis is kept (none is run).
+``--confusion``: the kept diagnoses only, per record (names, mass error named where none was
+put in, the friction's form taken) and their confusion matrix (``grid.scoring``).
 
 ``--make DIR``: writes literature-grid records into DIR as the grid makes them
 (config/config.yaml: 40 s at 256 Hz, ratio 0.5, the grid's seed offset): each of
@@ -145,6 +147,65 @@ def diagnose_all(records, fast: bool, jobs: int) -> None:
             print(f"diagnosed {Path(csv).stem}", flush=True)
 
 
+def _topology(d: dict) -> str:
+    """The friction's form the diagnosis took where the sidecar was silent ("ground", "base",
+    "base (untold)": the record could not tell; "" where none was compared), from its notes."""
+    for note in d.get("notes") or []:
+        if "does not say what the friction acts on" in note:
+            return ("ground" if "taken: relative to the ground" in note else
+                    "base" if "taken: relative to the base" in note else "base (untold)")
+    return ""
+
+
+def confusion(records) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(per record, confusion matrix) of the kept diagnoses: ``grid.scoring.score``'s row
+    beside the record, its recording kind, the names given, whether a mass error
+    (inertia_error) was named where none was put in, and the friction's form taken; friction
+    put on the ground is named right only with the form "ground". The matrix is
+    ``grid.scoring.confusion_matrix`` of the rows (true scenario x first name)."""
+    from harvester.grid.scoring import confusion_matrix, score
+    rows = []
+    for rec in records:
+        kept = rec.path.with_suffix(".diagnosis.json")
+        if not kept.is_file():
+            continue
+        d = json.loads(kept.read_text())
+        row = score({"effect": rec.path.stem, "seed": 0, **rec.truth}, d)
+        missing, form = list(d.get("missing") or []), _topology(d)
+        lit = rec.truth.get("literature") or {}
+        if (lit.get("effect") or {}).get("kind") == "ground_friction" and form != "ground" \
+                and row["outcome"] in ("named", "tied"):
+            row["outcome"] = "wrong"
+        rows.append({**row, "record": rec.path.stem,
+                     "kind": rec.truth.get("kind", "base_acc->rel_acc"),
+                     "correct": " ".join(sorted(rec.correct)) or "-",
+                     "names": " ".join(missing) or "-", "friction_form": form or "-",
+                     "mass_error_not_put_in": "inertia_error" in missing
+                     and "inertia_error" not in rec.correct})
+    table = pd.DataFrame(rows)
+    return table, confusion_matrix(table) if rows else pd.DataFrame()
+
+
+def print_confusion(records) -> None:
+    """The per-record table, the confusion matrix and the counts of :func:`confusion`."""
+    table, matrix = confusion(records)
+    if table.empty:
+        print("no kept diagnosis")
+        return
+    cols = ["record", "correct", "verdict", "outcome", "names", "friction_form",
+            "mass_error_not_put_in", "runtime_s"]
+    print(table[cols].to_string(index=False, float_format=lambda x: f"{x:.0f}"))
+    print()
+    print(matrix.to_string(index=False))
+    lib = table[~table["effect_free"] & (table["correct"] != "-")]
+    counts = lib["outcome"].value_counts().to_dict()
+    free = table[table["effect_free"]]
+    print(f"\nlibrary effects: {len(lib)} records, {counts}; outside the library: "
+          f"{int((~table['effect_free'] & (table['correct'] == '-')).sum())}; effect-free: "
+          f"{len(free)}, false alarms {int(free['flagged'].sum())}; mass error named where "
+          f"none was put in: {int(table['mass_error_not_put_in'].sum())}")
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--set", type=Path, help="folder of recordings with truth files")
@@ -165,6 +226,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--fast", action="store_true", help="the diagnosis's fast settings")
     p.add_argument("--jobs", type=int, default=1, help="diagnoses run at once")
     p.add_argument("--csv", type=Path, help="write the per-record rows here")
+    p.add_argument("--confusion", action="store_true", help="the kept diagnoses' names per "
+                   "record and their confusion matrix (grid.scoring), nothing run")
     args = p.parse_args(argv)
     clock = time.perf_counter()
     if args.make:
@@ -177,6 +240,9 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     from harvester.grid.peers import diagnosis_row, peer_rows, read_set, summary
     records = read_set(args.set)
+    if args.confusion:
+        print_confusion(records)
+        return 0
     if not (args.skip_diagnosis or args.kept_only):
         diagnose_all(records, args.fast, args.jobs)
     rows = []
