@@ -1644,10 +1644,20 @@ def generate(name: str, seed: int, ratio: float = 0.5, duration_s: float = 40.0,
     scen = SCENARIOS[name]
     rng_device, rng_excitation, rng_shape, rng_noise = _streams(name, seed)
     tb = TimeBase(fs, round(duration_s * fs))
+    rngs = (rng_device, rng_excitation, rng_shape, rng_noise)
     if kind != KINDS[0]:
-        return _generate_kind(scen, seed, ratio, duration_s, tb, kind, noise_scale,
-                              (rng_device, rng_excitation, rng_shape, rng_noise),
+        return _generate_kind(scen, seed, ratio, duration_s, tb, kind, noise_scale, rngs,
                               noise_rel_acc, friction_form)
+    return _generate_pair(scen, seed, ratio, duration_s, tb, rngs, noise_rel_acc, lsb,
+                          friction_form, shared_input_noise, sensor_resonance)
+
+
+def _generate_pair(scen: LiteratureScenario, seed: int, ratio: float, duration_s: float,
+                   tb: TimeBase, rngs: tuple, noise_rel_acc: float, lsb: float | None,
+                   friction_form: str, shared_input_noise: bool,
+                   sensor_resonance: tuple[float, float] | None) -> GeneratedRecording:
+    """:func:`generate` for the accelerometer pair, base_acc -> rel_acc."""
+    rng_device, rng_excitation, rng_shape, rng_noise = rngs
     sensor = noise_rel_acc / np.sqrt(2.0)
     noise = (sensor_noise(rng_noise, sensor, tb.n_out), sensor_noise(rng_noise, sensor, tb.n_out))
     if not shared_input_noise:
