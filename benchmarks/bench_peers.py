@@ -220,6 +220,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--kept-only", action="store_true",
                    help="the diagnosis only where a <name>.diagnosis.json is kept (none run)")
     p.add_argument("--no-narx", action="store_true", help="without the NARX free run")
+    p.add_argument("--diagnosis-only", action="store_true",
+                   help="the diagnosis's rows alone (no pysindy, no NARX)")
     p.add_argument("--real", action="store_true",
                    help="with --make: the shipped real recordings too (grid.recorded)")
     p.add_argument("--data", type=Path, default=DATA, help="folder of the real recordings")
@@ -251,7 +253,8 @@ def main(argv: list[str] | None = None) -> int:
         run = not args.skip_diagnosis and (kept or not args.kept_only)
         found = [diagnosis_row(rec, lambda r: run_diagnosis_cached(r, args.fast))] if run \
             else []
-        for r in found + peer_rows(rec, narx=not args.no_narx):
+        peers = [] if args.diagnosis_only else peer_rows(rec, narx=not args.no_narx)
+        for r in found + peers:
             rows.append({"record": rec.path.stem, "correct": " ".join(sorted(rec.correct)),
                          **r, "names": " ".join(r["names"])})
             print(f"{rec.path.stem:28s} {r['tool']:22s} {rows[-1]['outcome']:12s} "
