@@ -263,8 +263,8 @@ def _extra_force(kind, p, z, v, v_impact):
 
 @nb.njit(cache=True)
 def _contact(p, d, dd):
-    """Dead-zone coupling (Nordin and Gutman 2002, sec. 2.2, with a Kelvin-Voigt contact):
-    k_b dz(d, g) + c_b d' while in contact, compressive only (N)."""
+    """Dead-zone coupling (the dead-zone model, Nordin and Gutman 2002, with a Kelvin-Voigt
+    contact): k_b dz(d, g) + c_b d' while in contact, compressive only (N)."""
     g = p[E]
     if d > g:
         return max(p[E + 1] * (d - g) + p[E + 2] * dd, 0.0)
@@ -956,12 +956,12 @@ _CITE = {
                  "line pickup); Ewins, D.J. (2000) Modal Testing, 2nd ed. (mains hum in "
                  "transducer signals).",
     "dead_zone": "Nordin, M., Gutman, P.-O. (2002) Controlling mechanical systems with "
-                 "backlash - a survey. Automatica 38(10):1633-1649 (the dead-zone model, "
-                 "sec. 2); Tao, G., Kokotovic, P.V. (1996) Adaptive Control of Systems with "
+                 "backlash - a survey. Automatica 38(10):1633-1649 (the dead-zone model); "
+                 "Tao, G., Kokotovic, P.V. (1996) Adaptive Control of Systems with "
                  "Actuator and Sensor Nonlinearities. Wiley (dead zones).",
     "backlash": "Nordin, M., Gutman, P.-O. (2002) Controlling mechanical systems with backlash "
                 "- a survey. Automatica 38(10):1633-1649 (two inertias coupled through a "
-                "dead zone, sec. 2.2); contact damping from the restitution as Gilardi & "
+                "dead zone); contact damping from the restitution as Gilardi & "
                 "Sharf (2002), Mech. Mach. Theory 37(10).",
     "ground_friction": "Marino, L., Cicirello, A. (2023) A switching Gaussian process latent "
                        "force model for the identification of mechanical systems with a "
