@@ -153,8 +153,9 @@ CONVERGENCE_TOL, KARNOPP_CONVERGENCE_TOL = 1.0e-3, 1.0e-2
 #: Sub-steps are this many times finer in an internal step that may meet a contact or
 #: Karnopp's stick band.
 SWITCH_REFINE = 8
-#: Most RK4 sub-steps per internal sample (away from contacts and stick bands).
-MAX_SUBSTEPS = 64
+#: Most RK4 sub-steps per internal sample (away from contacts and stick bands); backlash's,
+#: whose contact switches on and off within the motion (RK4 at first order at each touch).
+MAX_SUBSTEPS, MAX_SUBSTEPS_BACKLASH = 64, 512
 #: Most shape draws per device, and devices per recording, before giving up.
 MAX_SHAPE_DRAWS, MAX_DEVICE_DRAWS = 12, 8
 #: Relative tolerance of the calibrated contribution RMS.
@@ -1457,7 +1458,8 @@ def _calibrate(run: _Run, scen: LiteratureScenario, device: Device, rng: np.rand
         kind, p = effect_params(device, scen.effect(ctx, shape, 0.0 if s is None else s))
         change = _step_change(run, device, kind, p, n_sub) / noise_rms
         tol = KARNOPP_CONVERGENCE_TOL if kind == KARNOPP else CONVERGENCE_TOL
-        if change <= tol or 2 * n_sub > MAX_SUBSTEPS:
+        if change <= tol or 2 * n_sub > (MAX_SUBSTEPS_BACKLASH if kind == BACKLASH
+                                         else MAX_SUBSTEPS):
             break
         n_sub *= 2
         if s is not None:
