@@ -160,7 +160,8 @@ def _topology(d: dict) -> str:
 def confusion(records) -> tuple[pd.DataFrame, pd.DataFrame]:
     """(per record, confusion matrix) of the kept diagnoses: ``grid.scoring.score``'s row
     beside the record, its recording kind, the names given, whether a mass error
-    (inertia_error) was named where none was put in, and the friction's form taken; friction
+    (inertia_error) was named where none was put in, the friction's form taken and whether
+    the time budget cut the search for names; friction
     put on the ground is named right only with the form "ground". The matrix is
     ``grid.scoring.confusion_matrix`` of the rows (true scenario x first name)."""
     from harvester.grid.scoring import confusion_matrix, score
@@ -180,6 +181,7 @@ def confusion(records) -> tuple[pd.DataFrame, pd.DataFrame]:
                      "kind": rec.truth.get("kind", "base_acc->rel_acc"),
                      "correct": " ".join(sorted(rec.correct)) or "-",
                      "names": " ".join(missing) or "-", "friction_form": form or "-",
+                     "budget_cut": bool((d.get("budget") or {}).get("cut")),
                      "mass_error_not_put_in": "inertia_error" in missing
                      and "inertia_error" not in rec.correct})
     table = pd.DataFrame(rows)
@@ -193,7 +195,7 @@ def print_confusion(records) -> None:
         print("no kept diagnosis")
         return
     cols = ["record", "correct", "verdict", "outcome", "names", "friction_form",
-            "mass_error_not_put_in", "runtime_s"]
+            "mass_error_not_put_in", "budget_cut", "runtime_s"]
     print(table[cols].to_string(index=False, float_format=lambda x: f"{x:.0f}"))
     print()
     print(matrix.to_string(index=False))
@@ -203,7 +205,8 @@ def print_confusion(records) -> None:
     print(f"\nlibrary effects: {len(lib)} records, {counts}; outside the library: "
           f"{int((~table['effect_free'] & (table['correct'] == '-')).sum())}; effect-free: "
           f"{len(free)}, false alarms {int(free['flagged'].sum())}; mass error named where "
-          f"none was put in: {int(table['mass_error_not_put_in'].sum())}")
+          f"none was put in: {int(table['mass_error_not_put_in'].sum())}; the time budget "
+          f"cut the search on {int(table['budget_cut'].sum())} of {len(table)}")
 
 
 def main(argv: list[str] | None = None) -> int:
