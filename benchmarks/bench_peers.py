@@ -5,6 +5,7 @@ seconds per record (``harvester.grid.peers``).
     python benchmarks/bench_peers.py --set DIR [--skip-diagnosis] [--no-narx] [--csv OUT]
     python benchmarks/bench_peers.py --make DIR [--effects duffing ...] [--free-seeds 0 1]
     python benchmarks/bench_peers.py --make DIR --real [--fast] [--jobs 2] --set DIR
+    python benchmarks/bench_peers.py --make DIR --kinds "base_disp->rel_disp" --duration 20
 
 ``--set DIR``: any folder of acceleration recordings (``<name>.csv`` with its sidecar
 ``<name>.yaml``) each with a truth ``<name>.json`` (``correct_names``, ``ratio``; as the
@@ -15,12 +16,15 @@ thresholds, SysIdentPy's polynomial NARX free run. pysindy and sysidentpy: ``pip
 -e .[peers]``.
 
 ``--kept-only``: the diagnosis's rows only for records whose diagnosis is kept (none is run).
+``--confusion``: the kept diagnoses only, per record (names, mass error named where none was
+put in, the friction's form taken) and their confusion matrix (``grid.scoring``).
 
 ``--make DIR``: writes literature-grid records into DIR as the grid makes them
 (config/config.yaml: 40 s at 256 Hz, ratio 0.5, the grid's seed offset): each of
 ``--effects`` at seed 0 and the effect-free record at each of ``--free-seeds``
-(``--effects`` with no name: none). ``--real``: the shipped real recordings too (the frame at
-250 g and 450 g, the Silverbox; ``grid.recorded``: their truths and why), read from
+(``--effects`` with no name: none), of each of ``--kinds`` (the generator's recording kinds,
+``literature.KINDS``; default base_acc->rel_acc), ``--duration`` s each. ``--real``: the
+shipped real recordings too (the frame at 250 g and 450 g, the Silverbox; ``grid.recorded``: their truths and why), read from
 ``--data`` (default data/public); their diagnosis is ``diagnosis.diagnose_recording``, the
 command line's call on the file, against the study's linear baseline.
 
@@ -48,22 +52,36 @@ EFFECTS = ("duffing", "quadratic_damping", "stribeck_exponential", "end_stop_her
 DATA = ROOT / "data" / "public"
 
 
-def make_set(out: Path, effects, free_seeds) -> None:
-    """The grid's records (and truths, sidecars) of ``effects`` and effect-free seeds."""
+#: File-name tags of the literature generator's recording kinds (the default's: none).
+KIND_TAGS = {"base_acc->rel_acc": "", "base_disp->rel_disp": "_dd", "base_disp->rel_acc": "_da",
+             "force->rel_disp": "_fd"}
+
+
+def make_set(out: Path, effects, free_seeds, kinds=("base_acc->rel_acc",),
+             duration_s: float | None = None) -> None:
+    """The grid's records (and truths, sidecars) of ``effects`` and effect-free seeds, of
+    each recording kind of ``kinds`` (``<effect><tag>_s<seed>``, :data:`KIND_TAGS`), lasting
+    ``duration_s`` (None: the grid's). A scenario a kind cannot express (friction on the
+    ground with a force input) is skipped with a line saying why."""
     from harvester.grid.generators import make_scenario_files
     cfg = yaml.safe_load(CONFIG.read_text())
     det, grid = cfg["detection"], cfg["detection"]["grids"]["literature"]
-    settings = {"duration_s": float(grid["duration_s"]), "lead_in_s": float(det["lead_in_s"]),
-                "seed": int(det["seed"])}
+    settings = {"duration_s": float(duration_s or grid["duration_s"]),
+                "lead_in_s": float(det["lead_in_s"]), "seed": int(det["seed"])}
     out.mkdir(parents=True, exist_ok=True)
-    jobs = [(e, float(grid["ratios"][0]), 0) for e in effects] + \
-        [("none", 0.0, s) for s in free_seeds]
-    for effect, ratio, seed in jobs:
-        csv = out / f"{effect}_s{seed}.csv"
+    jobs = [(e, float(grid["ratios"][0]), 0, k) for k in kinds for e in effects] + \
+        [("none", 0.0, s, k) for k in kinds for s in free_seeds]
+    for effect, ratio, seed, kind in jobs:
+        csv = out / f"{effect}{KIND_TAGS[kind]}_s{seed}.csv"
         if csv.is_file():
             continue
-        truth = make_scenario_files("literature", effect, ratio, seed, settings, cfg["rig"],
-                                    cfg["preprocess"], csv, csv.with_suffix(".json"))
+        try:
+            truth = make_scenario_files("literature", effect, ratio, seed,
+                                        {**settings, "kind": kind}, cfg["rig"],
+                                        cfg["preprocess"], csv, csv.with_suffix(".json"))
+        except ValueError as err:
+            print(f"skipped {csv.name}: {err}", flush=True)
+            continue
         csv.with_suffix(".yaml").write_text("".join(f"{k}: {float(v)!r}\n"
                                                     for k, v in truth["known"].items()))
         print(f"made {csv.name}", flush=True)
@@ -129,26 +147,96 @@ def diagnose_all(records, fast: bool, jobs: int) -> None:
             print(f"diagnosed {Path(csv).stem}", flush=True)
 
 
+def _topology(d: dict) -> str:
+    """The friction's form the diagnosis took where the sidecar was silent ("ground", "base",
+    "base (untold)": the record could not tell; "" where none was compared), from its notes."""
+    for note in d.get("notes") or []:
+        if "does not say what the friction acts on" in note:
+            return ("ground" if "taken: relative to the ground" in note else
+                    "base" if "taken: relative to the base" in note else "base (untold)")
+    return ""
+
+
+def confusion(records) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(per record, confusion matrix) of the kept diagnoses: ``grid.scoring.score``'s row
+    beside the record, its recording kind, the names given, whether a mass error
+    (inertia_error) was named where none was put in, the friction's form taken and whether
+    the time budget cut the search for names; friction
+    put on the ground is named right only with the form "ground". The matrix is
+    ``grid.scoring.confusion_matrix`` of the rows (true scenario x first name)."""
+    from harvester.grid.scoring import confusion_matrix, score
+    rows = []
+    for rec in records:
+        kept = rec.path.with_suffix(".diagnosis.json")
+        if not kept.is_file():
+            continue
+        d = json.loads(kept.read_text())
+        row = score({"effect": rec.path.stem, "seed": 0, **rec.truth}, d)
+        missing, form = list(d.get("missing") or []), _topology(d)
+        lit = rec.truth.get("literature") or {}
+        if (lit.get("effect") or {}).get("kind") == "ground_friction" and form != "ground" \
+                and row["outcome"] in ("named", "tied"):
+            row["outcome"] = "wrong"
+        rows.append({**row, "record": rec.path.stem,
+                     "kind": rec.truth.get("kind", "base_acc->rel_acc"),
+                     "correct": " ".join(sorted(rec.correct)) or "-",
+                     "names": " ".join(missing) or "-", "friction_form": form or "-",
+                     "budget_cut": bool((d.get("budget") or {}).get("cut")),
+                     "mass_error_not_put_in": "inertia_error" in missing
+                     and "inertia_error" not in rec.correct})
+    table = pd.DataFrame(rows)
+    return table, confusion_matrix(table) if rows else pd.DataFrame()
+
+
+def print_confusion(records) -> None:
+    """The per-record table, the confusion matrix and the counts of :func:`confusion`."""
+    table, matrix = confusion(records)
+    if table.empty:
+        print("no kept diagnosis")
+        return
+    cols = ["record", "correct", "verdict", "outcome", "names", "friction_form",
+            "mass_error_not_put_in", "budget_cut", "runtime_s"]
+    print(table[cols].to_string(index=False, float_format=lambda x: f"{x:.0f}"))
+    print()
+    print(matrix.to_string(index=False))
+    lib = table[~table["effect_free"] & (table["correct"] != "-")]
+    counts = lib["outcome"].value_counts().to_dict()
+    free = table[table["effect_free"]]
+    print(f"\nlibrary effects: {len(lib)} records, {counts}; outside the library: "
+          f"{int((~table['effect_free'] & (table['correct'] == '-')).sum())}; effect-free: "
+          f"{len(free)}, false alarms {int(free['flagged'].sum())}; mass error named where "
+          f"none was put in: {int(table['mass_error_not_put_in'].sum())}; the time budget "
+          f"cut the search on {int(table['budget_cut'].sum())} of {len(table)}")
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--set", type=Path, help="folder of recordings with truth files")
     p.add_argument("--make", type=Path, help="write literature-grid records into this folder")
     p.add_argument("--effects", nargs="*", default=list(EFFECTS))
     p.add_argument("--free-seeds", nargs="*", type=int, default=[0, 1])
+    p.add_argument("--kinds", nargs="*", default=["base_acc->rel_acc"],
+                   help="with --make: the literature generator's recording kinds")
+    p.add_argument("--duration", type=float, help="with --make: seconds per record "
+                   "(default: the grid's)")
     p.add_argument("--skip-diagnosis", action="store_true", help="the peers only")
     p.add_argument("--kept-only", action="store_true",
                    help="the diagnosis only where a <name>.diagnosis.json is kept (none run)")
     p.add_argument("--no-narx", action="store_true", help="without the NARX free run")
+    p.add_argument("--diagnosis-only", action="store_true",
+                   help="the diagnosis's rows alone (no pysindy, no NARX)")
     p.add_argument("--real", action="store_true",
                    help="with --make: the shipped real recordings too (grid.recorded)")
     p.add_argument("--data", type=Path, default=DATA, help="folder of the real recordings")
     p.add_argument("--fast", action="store_true", help="the diagnosis's fast settings")
     p.add_argument("--jobs", type=int, default=1, help="diagnoses run at once")
     p.add_argument("--csv", type=Path, help="write the per-record rows here")
+    p.add_argument("--confusion", action="store_true", help="the kept diagnoses' names per "
+                   "record and their confusion matrix (grid.scoring), nothing run")
     args = p.parse_args(argv)
     clock = time.perf_counter()
     if args.make:
-        make_set(args.make, args.effects, args.free_seeds)
+        make_set(args.make, args.effects, args.free_seeds, args.kinds, args.duration)
         if args.real:
             from harvester.grid.recorded import write_recorded_set
             for csv in write_recorded_set(args.data, args.make):
@@ -157,6 +245,9 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     from harvester.grid.peers import diagnosis_row, peer_rows, read_set, summary
     records = read_set(args.set)
+    if args.confusion:
+        print_confusion(records)
+        return 0
     if not (args.skip_diagnosis or args.kept_only):
         diagnose_all(records, args.fast, args.jobs)
     rows = []
@@ -165,7 +256,8 @@ def main(argv: list[str] | None = None) -> int:
         run = not args.skip_diagnosis and (kept or not args.kept_only)
         found = [diagnosis_row(rec, lambda r: run_diagnosis_cached(r, args.fast))] if run \
             else []
-        for r in found + peer_rows(rec, narx=not args.no_narx):
+        peers = [] if args.diagnosis_only else peer_rows(rec, narx=not args.no_narx)
+        for r in found + peers:
             rows.append({"record": rec.path.stem, "correct": " ".join(sorted(rec.correct)),
                          **r, "names": " ".join(r["names"])})
             print(f"{rec.path.stem:28s} {r['tool']:22s} {rows[-1]['outcome']:12s} "

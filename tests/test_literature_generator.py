@@ -78,9 +78,9 @@ def test_every_effect_at_zero_strength_is_the_baseline():
     base = _output(run, tb, L.NONE, DEVICE.params())
     rng = np.random.default_rng(0)
     for name, scen in L.SCENARIOS.items():
-        if name == "none" or scen.family in ("end stop contact",
+        if name == "none" or scen.family in ("end stop contact", "backlash",
                                               "flexible mount / secondary mode"):
-            continue  # a rigid mount / massless mode / grazing stop: tested apart
+            continue  # a rigid mount / massless mode / grazing stop / contact: tested apart
         kind, p = L.effect_params(DEVICE, scen.effect(ctx, scen.draw_shape(rng, ctx), 0.0))
         out = _output(run, tb, kind, p)
         # equal up to the finer sub-steps taken near a stop or the stick band
@@ -192,20 +192,23 @@ def _reference(kind, p, tb, run, t_end):
     memory = L.LUGRE <= kind <= L.BOUC_WEN
     exc = run.excitation
 
+    ground = kind == L.GROUND_FRICTION  # x[4], the base velocity, is a state of its own
+
     def f(t, x):
-        xx, dx = np.append(x, p[L._VREF]), np.zeros(5)
+        xx, dx = (x.copy() if ground else np.append(x, p[L._VREF])), np.zeros(5)
         L._rhs(kind, p, xx, float(exc.at(t)[0]), dx)
         if memory:
             rate_p, rate_q = L._memory_rates(kind, p, x[1], x[2])
             dx[2] = rate_p - rate_q * x[2]
-        return dx[:4]
+        return dx if ground else dx[:4]
 
     times = np.arange(int(t_end / tb.h_int)) * tb.h_int
-    sol = solve_ivp(f, (0.0, times[-1]), np.zeros(4), method="Radau", t_eval=times,
+    start = np.append(np.zeros(4), p[L._VREF]) if ground else np.zeros(4)
+    sol = solve_ivp(f, (0.0, times[-1]), start, method="Radau", t_eval=times,
                     rtol=1e-10, atol=1e-13)
     assert sol.success
     dx = np.zeros(5)
-    states = np.vstack([sol.y, np.full(times.size, p[L._VREF])])
+    states = sol.y if ground else np.vstack([sol.y, np.full(times.size, p[L._VREF])])
     return np.array([L._rhs(kind, p, states[:, i], float(exc.at(t)[0]), dx)
                      for i, t in enumerate(times)])
 
@@ -228,6 +231,8 @@ def _convergence(kind, values, t_end=1.0):
 @pytest.mark.parametrize("kind,values", [
     (L.NONE, []),
     (L.LUGRE, [0.5, 1e4, 2 * 0.5 * np.sqrt(1e4 * 2.0)]),
+    (L.GROUND_FRICTION, [0.6]),
+    (L.SPRING_DEAD_ZONE, [2e-3]),
 ])
 def test_integrator_converges_to_the_radau_reference(kind, values):
     """Errors shrink under step halving (RK4; the memory laws' splitting is ~2nd order) and
@@ -558,3 +563,138 @@ def test_the_input_noise_can_be_the_recordings_own():
     assert abs(np.corrcoef(rel_noise, base_noise)[0, 1]) < 0.1
     shared_noise = (shared.recording.rel_acc - shared.clean_rel_acc).to_numpy()
     assert np.corrcoef(shared_noise, base_noise)[0, 1] < -0.6
+
+
+# --------------------------------------------------------------------------- recording kinds
+
+#: base_acc -> rel_acc records of the code before the recording kinds were added (seed 0, 6 s):
+#: samples 300, 900, 1400 of base_acc and rel_acc, to the CSV's 10 digits.
+DEFAULT_KIND_SAMPLES = {
+    "karnopp": ([-1.95477209871, 0.328763643106, -3.40808783658],
+                [4.05951833655, -0.660854962993, 3.32710127204]),
+    "none": ([1.53388276967, -0.334465717394, 0.030945919602],
+             [-2.6513424038, -0.364115839082, -0.0605895895612]),
+}
+
+
+@pytest.mark.parametrize("name", sorted(DEFAULT_KIND_SAMPLES))
+def test_the_default_kind_records_what_it_recorded_before(name):
+    g = L.generate(name, 0, duration_s=6.0)
+    assert list(g.recording.columns) == ["time", "base_acc", "rel_acc"]
+    base, rel = DEFAULT_KIND_SAMPLES[name]
+    np.testing.assert_allclose(g.recording["base_acc"].to_numpy()[[300, 900, 1400]], base,
+                               rtol=1e-9)
+    np.testing.assert_allclose(g.recording["rel_acc"].to_numpy()[[300, 900, 1400]], rel,
+                               rtol=1e-9)
+    assert "recording_kind" not in g.truth
+
+
+def test_the_base_motion_is_the_double_integral_of_the_input_without_a_trend():
+    tb, run, _ = _setup(4.0)
+    v, y = run.base_motion
+    h = tb.h_int
+    inner = slice(8, -8)
+    acc = np.gradient(np.gradient(y, h), h)
+    np.testing.assert_allclose(acc[inner], run.base_internal()[inner], atol=2e-3 * np.std(
+        run.base_internal()))
+    np.testing.assert_allclose(np.gradient(y, h)[inner], v[inner], atol=1e-3 * np.std(v))
+    record = slice(0, (tb.n_out - 1) * L.OVERSAMPLE + 1)
+    t = h * np.arange(y.size)
+    slope = np.polyfit(t[record], y[record], 1)[0]
+    assert abs(slope) * t[record][-1] < 1e-4 * np.std(y[record])
+
+
+def _quiet(name, kind, seed=5):
+    return L.generate(name, seed, duration_s=6.0, kind=kind, noise_scale=1e-6)
+
+
+def test_the_kinds_record_one_motion_through_their_own_channels():
+    """One device and excitation per seed, whatever the kind: rel_acc is z'' of rel_disp, the
+    base displacement's second derivative the base acceleration, and the force -m y''
+    moves the mass (base fixed) as the base acceleration y'' moves it relative to the base."""
+    dd, da, fd = (_quiet("none", k) for k in L.KINDS[1:])
+    assert dd.sidecar == da.sidecar == fd.sidecar
+    assert list(dd.recording.columns) == ["time", "base_disp", "rel_disp"]
+    assert list(da.recording.columns) == ["time", "base_disp", "rel_acc"]
+    assert list(fd.recording.columns) == ["time", "force", "rel_disp"]
+    from harvester.data.kinds import derivative  # the diagnosis's own (band-limited)
+    dt, inner = 1.0 / FS, slice(256, -256)
+    z, acc = dd.recording["rel_disp"].to_numpy(), da.recording["rel_acc"].to_numpy()
+    z2 = derivative(z, dt, 2, None)
+    assert L._rms((z2 - acc)[inner]) < 1e-2 * L._rms(acc[inner])  # its low-pass: 0.45 %
+    np.testing.assert_allclose(fd.recording["rel_disp"], dd.recording["rel_disp"],
+                               atol=1e-5 * L._rms(z))
+    y2 = derivative(dd.recording["base_disp"].to_numpy(), dt, 2, None)
+    force = fd.recording["force"].to_numpy()
+    assert L._rms((force + dd.sidecar["m"] * y2)[inner]) < 1e-2 * L._rms(force[inner])
+
+
+@pytest.mark.parametrize("kind", L.KINDS[1:])
+def test_each_channel_has_its_share_of_noise(kind):
+    """In what the diagnosis takes of each channel (its own band-limited derivative:
+    y'' of a base displacement, z' of a relative one)."""
+    from harvester.data.kinds import derivative
+    g = L.generate("none", 5, duration_s=6.0, kind=kind)
+    quiet = _quiet("none", kind)
+    inp, out = kind.split("->")
+    inner = slice(256, -256)
+    for col in (inp, out):
+        order = L.NOISE_ORDER[col]  # order 0: the channel (derivative takes its end line off)
+        noisy, clean = ((derivative(r.recording[col].to_numpy(), 1.0 / FS, order, None)
+                         if order else r.recording[col].to_numpy())[inner] for r in (g, quiet))
+        assert L._rms(noisy - clean) == pytest.approx(L.NOISE_SHARES[col] * L._rms(clean),
+                                                      rel=0.15), col
+    assert g.truth["noise_rms_output"] == pytest.approx(L._rms(
+        (g.recording[out] - quiet.recording[out]).to_numpy()[256:]), rel=1e-3)
+    assert g.truth["recording_kind"] == kind
+
+
+NEW = ("spring_dead_zone", "backlash", "ground_friction")
+
+
+@pytest.mark.parametrize("name,kind", [(n, k) for n in NEW for k in L.KINDS
+                                       if not (n == "ground_friction" and k[0] == "f")])
+def test_the_new_scenarios_reach_their_ratio_on_every_kind(name, kind):
+    g = L.generate(name, 11, duration_s=6.0, kind=kind)
+    noise = g.truth.get("noise_rms_output", g.truth.get("noise_rms_rel_acc"))
+    achieved = L._rms(g.contribution[256:]) / noise
+    assert achieved == pytest.approx(0.5, rel=0.01)
+    assert g.truth["ratio_achieved"] == pytest.approx(achieved, rel=1e-12)
+    assert g.truth["integration"]["step_halving_change_to_noise"] <= L.CONVERGENCE_TOL
+
+
+def test_ground_friction_is_refused_with_a_force_input_and_an_unknown_kind_is_named():
+    with pytest.raises(ValueError, match="the base is fixed"):
+        L.generate("ground_friction", 0, duration_s=4.0, kind="force->rel_disp")
+    with pytest.raises(ValueError, match="unknown recording kind"):
+        L.generate("none", 0, duration_s=4.0, kind="force->rel_acc")
+    with pytest.raises(ValueError, match="accelerometer pair"):
+        L.generate("none", 0, duration_s=4.0, kind="base_disp->rel_disp", lsb=1e-3)
+
+
+def test_the_spring_dead_zone_and_the_backlash_contact_are_dead_zones():
+    """k z + the dead zone's extra force = k dz(z, g); the coupling is zero inside the gap,
+    compressive only outside."""
+    p = DEVICE.params()
+    p[L.E] = 2e-3
+    for z in (-5e-3, -1e-3, 0.0, 1.5e-3, 4e-3):
+        dz = np.sign(z) * max(abs(z) - 2e-3, 0.0)
+        assert DEVICE.k * z + L._extra_force(L.SPRING_DEAD_ZONE, p, z, 0.0, 0.0) == \
+            pytest.approx(DEVICE.k * dz, abs=1e-12)
+    p[L.E: L.E + 3] = [1e-3, 1e5, 10.0]
+    assert L._contact(p, 0.9e-3, 5.0) == 0.0 and L._contact(p, -0.5e-3, -5.0) == 0.0
+    assert L._contact(p, 2e-3, 0.0) == pytest.approx(1e5 * 1e-3)
+    assert L._contact(p, 1.1e-3, -2.0) == 0.0  # separating faster than pressed: no pull
+
+
+def test_backlash_without_a_gap_and_a_stiff_contact_is_the_one_body_device():
+    tb, run, ctx = _setup()
+    base = _output(run, tb, L.NONE, DEVICE.params())
+    mu = DEVICE.m * (DEVICE.M - DEVICE.m) / DEVICE.M
+    k_b = mu * (2 * np.pi * 400.0) ** 2
+    p = DEVICE.params()
+    p[L.E: L.E + 3] = [0.0, k_b, 2 * 0.7 * np.sqrt(k_b * mu)]
+    out = _output(run, tb, L.BACKLASH, p, n_sub=8)
+    assert L._rms(out - base) < 0.02 * L._rms(base)
+    p[L.E] = 0.5 * ctx.z_rms  # a gap: the mass loses the screw side's inertia in it
+    assert L._rms(_output(run, tb, L.BACKLASH, p, n_sub=8) - base) > 0.05 * L._rms(base)

@@ -10,7 +10,10 @@ excitation and an anti-aliased DAQ. Only the second says whether the diagnosis g
 Truth keys the scoring reads (:func:`harvester.grid.scoring.score`): ``effect`` (scenario
 name), ``ratio``, ``seed``, ``baseline``, ``known`` (M, m, k), ``settings.lead_in_s``,
 ``contribution_ratio``, ``unabsorbed_to_noise``, ``peak_to_noise``, and for the literature
-generator ``correct_names`` (the library terms that name its mechanism).
+generator ``correct_names`` (the library terms that name its mechanism). ``settings.kind``:
+the literature generator's recording kind (``literature.KINDS``; its records of a kind other
+than base_acc -> rel_acc are diagnosed as the command line reads the file, ``diagnose:
+recording``, so that the sidecar's silence about friction_on is read as a user's).
 """
 
 from __future__ import annotations
@@ -70,12 +73,13 @@ def literature_refit(made) -> float:
 def _literature(effect, ratio, seed, settings, csv_path, truth_path):
     from harvester.data.daq import write_recording
     from harvester.data.fileio import write_json
-    from harvester.synthetic.literature import LEAD_IN_S, generate
+    from harvester.synthetic.literature import KINDS, LEAD_IN_S, generate
 
     effect_free = effect == LITERATURE_NONE
+    kind = settings.get("kind", KINDS[0])
     made = generate(effect, seed + int(settings.get("seed", 0)),
                     ratio=0.0 if effect_free else ratio,
-                    duration_s=float(settings["duration_s"]))
+                    duration_s=float(settings["duration_s"]), kind=kind)
     lit = made.truth
     truth = {
         "effect": effect, "ratio": 0.0 if effect_free else float(ratio), "seed": int(seed),
@@ -83,14 +87,17 @@ def _literature(effect, ratio, seed, settings, csv_path, truth_path):
         "settings": {"lead_in_s": LEAD_IN_S, "duration_s": float(settings["duration_s"])},
         "contribution_ratio": float(lit.get("ratio_achieved", 0.0)),
         "unabsorbed_to_noise": float(lit.get("unabsorbed_to_noise", 0.0)),
-        "refit_unabsorbed_to_noise": 0.0 if effect_free else literature_refit(made),
         "peak_to_noise": float(lit.get("peak_to_noise", 0.0)),
-        "noise_rms": float(lit.get("noise_rms_rel_acc", float("nan"))),
+        "noise_rms": float(lit.get("noise_rms_rel_acc", lit.get("noise_rms_output"))),
         "invisible": False,
         "correct_names": list(lit.get("correct_names") or []),
         "related_names": list(lit.get("related_names") or []),
         "literature": lit,
     }
+    if kind == KINDS[0]:  # the refit is of base_acc -> rel_acc records
+        truth["refit_unabsorbed_to_noise"] = 0.0 if effect_free else literature_refit(made)
+    else:  # the command line's call on the file (its sidecar silent about friction_on)
+        truth.update(kind=kind, diagnose="recording")
     write_recording(made.recording, csv_path)
     write_json(truth, truth_path)
     return truth

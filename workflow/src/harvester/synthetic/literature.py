@@ -6,6 +6,16 @@ acquisition come from the published models cited per scenario, so that a diagnos
 it is tested on physics it was not written from. ``generate(name, seed)`` returns the
 recording (``time, base_acc, rel_acc``), its sidecar (the "known" M, m, k) and the truth.
 
+Recording kinds (``kind``, :data:`KINDS`; the same device, excitation and effect per seed):
+``base_acc->rel_acc`` (default) the two accelerometers below; ``base_disp->rel_disp`` the
+base displacement y (y'' integrated twice, with the constant base velocity that leaves y no
+straight-line trend) and the relative displacement z; ``base_disp->rel_acc`` y and z'';
+``force->rel_disp`` the base fixed and the force F = -m y'' on the mass (eq. 1 is then driven
+by F, the motion the same), z (to ground). Their channels each carry their own white noise
+through the DAQ, sized by what the model takes of the channel (y'' of a base displacement,
+z' of a relative one: :data:`NOISE_SHARES`); the strength's ratio is to the realised noise
+RMS of the recorded output.
+
 Device (:func:`draw_device`, per seed): eq. (1) of Green et al. (2015), a base-excited
 oscillator ``M z'' + c z' + k z + F_c S(z'/v_t) = -m y''``, z = x - y, M the effective mass
 (m plus the rotor's reflected inertia); f_n 0.5-8 Hz, M 0.5-20 kg, m/M 0.3-0.95, zeta
@@ -43,7 +53,20 @@ quadratic_spring        k2 z^2 (a spring stiffer on one side)       -- (offset_f
 friction_drift          F_dev (1 + s (t - T/2) / T), T the record   -- (none)
 mains_hum               rel_acc + A sin(2 pi 50|60 Hz t + phi)      -- (unmodelled_mode)
 maxwell_slip            (1-s) F_dev + s 2 Maxwell-slip elements     hysteresis, sticking (coulomb)
+spring_dead_zone        k dz(z, g) in place of k z, g = s z_max     -- (end_stop, backlash)
+backlash                2 DOF: m, J = M - m through a play +-g      backlash (mode, end_stop)
+ground_friction         (1-s) F_dev + s F_c S((z' + y')/v_t)        coulomb* (sticking, ...)
 ======================  ==========================================  =========================
+
+The last three were added after Maxwell-slip (issue 63). A dead zone in the main spring
+(Nordin and Gutman 2002) has no library term: end_stop adds a stiffness beyond a gap (it would
+need the spring removed), backlash couples the mass to the screw side. Backlash: the mass m
+carries the spring, the screw side J = M - m the damping and friction, coupled through a
+Kelvin-Voigt contact beyond +-g. Friction on the ground (a contact fixed to the frame, as in
+Marino and Cicirello 2023) moves a share s to the mass's absolute velocity; the sidecar is
+silent about ``friction_on``. *A friction name is right only where the diagnosis also takes
+the topology "ground" (base_disp inputs); with a force input the base is the ground and the
+form is the baseline itself (refused), with base_acc y' is the band-limited integral of y''.
 
 The four after the effect-free one are outside the library (no correct name): a force
 periodic in the displacement (a generator's cogging through the screw), an even spring, a
@@ -130,8 +153,9 @@ CONVERGENCE_TOL, KARNOPP_CONVERGENCE_TOL = 1.0e-3, 1.0e-2
 #: Sub-steps are this many times finer in an internal step that may meet a contact or
 #: Karnopp's stick band.
 SWITCH_REFINE = 8
-#: Most RK4 sub-steps per internal sample (away from contacts and stick bands).
-MAX_SUBSTEPS = 64
+#: Most RK4 sub-steps per internal sample (away from contacts and stick bands); backlash's,
+#: whose contact switches on and off within the motion (RK4 at first order at each touch).
+MAX_SUBSTEPS, MAX_SUBSTEPS_BACKLASH = 64, 512
 #: Most shape draws per device, and devices per recording, before giving up.
 MAX_SHAPE_DRAWS, MAX_DEVICE_DRAWS = 12, 8
 #: Relative tolerance of the calibrated contribution RMS.
@@ -145,7 +169,7 @@ N_PARAMS = E + 8
 # Effect kinds of the compiled right-hand side.
 (NONE, LUGRE, DAHL, BOUC_WEN, KARNOPP, STRIBECK, ASYMMETRIC, STOP_KV, STOP_POWER,
  SPRING_POWER, DAMP_POWER, MOUNT, SECONDARY, PERIODIC_Z, SPRING_EVEN, FRICTION_DRIFT,
- SENSOR_LINE, MAXWELL_SLIP) = range(18)
+ SENSOR_LINE, MAXWELL_SLIP, GROUND_FRICTION, SPRING_DEAD_ZONE, BACKLASH) = range(21)
 
 
 # --------------------------------------------------------------------------- compiled physics
@@ -233,7 +257,34 @@ def _extra_force(kind, p, z, v, v_impact):
         return p[E] * np.sin(2.0 * np.pi * z / p[E + 1] + p[E + 2])
     if kind == SPRING_EVEN:
         return p[E] * z * z
+    if kind == SPRING_DEAD_ZONE:  # k dz(z, g) in place of k z: k dz - k z = -k clip(z, +-g)
+        return -p[_K] * min(max(z, -p[E]), p[E])
     return 0.0
+
+
+@nb.njit(cache=True)
+def _contact(p, d, dd):
+    """Dead-zone coupling (the dead-zone model, Nordin and Gutman 2002, with a Kelvin-Voigt
+    contact): k_b dz(d, g) + c_b d' while in contact, compressive only (N)."""
+    g = p[E]
+    if d > g:
+        return max(p[E + 1] * (d - g) + p[E + 2] * dd, 0.0)
+    if d < -g:
+        return min(p[E + 1] * (d + g) + p[E + 2] * dd, 0.0)
+    return 0.0
+
+
+@nb.njit(cache=True)
+def _rhs_backlash(p, x, yb, dx):
+    """Backlash between the mass m (spring k) and the screw side J = M - m (c and the
+    friction on its velocity r'): m z'' = -m y'' - k z - F_b, J r'' = F_b - c r' - F(r')."""
+    z, v, r, dr = x[0], x[1], x[2], x[3]
+    fb = _contact(p, z - r, v - dr)
+    acc = (-p[_MOSC] * yb - p[_K] * z - fb) / p[_MOSC]
+    dx[0], dx[1], dx[2] = v, acc, dr
+    dx[3] = (fb - p[_C] * dr - _kinetic(p, dr)) / (p[_M] - p[_MOSC])
+    dx[4] = 0.0
+    return acc
 
 
 @nb.njit(cache=True)
@@ -272,24 +323,29 @@ def _rhs(kind, p, x, yb, dx):
     """d(state)/dt into dx for base acceleration yb (m/s^2); returns z'' (m/s^2).
 
     State: z, z', then the effect's: memory variable (kept by :func:`_relax`), or the second
-    body's displacement and velocity; x[4] holds the last impact velocity of a stop, or the
-    time for a drifting friction (started at p[_VREF] = 0).
+    body's displacement and velocity; x[4] holds the last impact velocity of a stop, the
+    time for a drifting friction (started at p[_VREF] = 0), or the base velocity y' for
+    friction on the ground (started at p[_VREF] = y'(0), :attr:`_Run.base_motion`).
     """
     if kind == MOUNT:
         return _rhs_mount(p, x, yb, dx)
     if kind == SECONDARY:
         return _rhs_secondary(p, x, yb, dx)
+    if kind == BACKLASH:
+        return _rhs_backlash(p, x, yb, dx)
     z, v = x[0], x[1]
     rest = -p[_MOSC] * yb - p[_C] * v - p[_K] * z - _extra_force(kind, p, z, v, x[4])
     if kind == FRICTION_DRIFT:  # x[4] holds the time (s)
         acc = (rest - _kinetic(p, v) * (1.0 + p[E] * (x[4] - p[E + 1]) / p[E + 2])) / p[_M]
     elif kind == MAXWELL_SLIP:  # sliders x[2], x[3], moved by _play
         acc = (rest - (1.0 - p[E]) * _kinetic(p, v) - _slip_force(p, z, x[2], x[3])) / p[_M]
+    elif kind == GROUND_FRICTION:  # x[4] holds the base velocity y' (m/s)
+        acc = (rest - (1.0 - p[E]) * _kinetic(p, v) - p[E] * _kinetic(p, v + x[4])) / p[_M]
     else:
         acc = (rest - _friction(kind, p, v, x[2], rest)) / p[_M]
     dx[0], dx[1] = v, acc
     dx[2] = dx[3] = 0.0
-    dx[4] = 1.0 if kind == FRICTION_DRIFT else 0.0
+    dx[4] = 1.0 if kind == FRICTION_DRIFT else yb if kind == GROUND_FRICTION else 0.0
     return acc
 
 
@@ -402,6 +458,8 @@ def _near_switch(kind, p, x, acc, h_int):
         return abs(x[0]) + reach >= p[E + 3]
     if kind == KARNOPP:
         return abs(x[1]) - abs(acc) * h_int <= p[E + 2]
+    if kind == BACKLASH:  # the contact's edge |z - r| = g within two steps' travel
+        return abs(abs(x[0] - x[2]) - p[E]) <= 2.0 * abs(x[1] - x[3]) * h_int + 1e-12
     return False
 
 
@@ -643,10 +701,11 @@ def simulate(kind: int, p: np.ndarray, y2: np.ndarray, tb: TimeBase,
 
 
 class _Run:
-    """One record's excitation and time base: its input grid and (cached) simulated outputs."""
+    """One record's excitation and time base: its input grid and (cached) simulated outputs;
+    ``channel``: the recorded output, z'' ("acc") or z ("disp")."""
 
-    def __init__(self, excitation: Excitation, tb: TimeBase):
-        self.excitation, self.tb = excitation, tb
+    def __init__(self, excitation: Excitation, tb: TimeBase, channel: str = "acc"):
+        self.excitation, self.tb, self.channel = excitation, tb, channel
         self._outputs: dict[tuple, np.ndarray] = {}
         self.sims = 0
 
@@ -659,15 +718,31 @@ class _Run:
         """y'' (m/s^2) at the internal samples."""
         return self.grid[: 2 * self.tb.n_int: 2]
 
+    @functools.cached_property
+    def base_motion(self) -> tuple[np.ndarray, np.ndarray]:
+        """(y', y) (m/s, m) at the internal samples: y'' integrated twice (trapezoid on the
+        input grid) with the constant base velocity that leaves y no straight-line trend over
+        the record (least squares: a base that returns to where it oscillates; y'(0) is minus
+        that constant), y about its mean. A constant y' leaves y'' unchanged."""
+        h, n = 0.5 * self.tb.h_int, 2 * self.tb.n_int
+        g = self.grid[:n]
+        v = np.concatenate([[0.0], np.cumsum(0.5 * h * (g[1:] + g[:-1]))])
+        y = np.concatenate([[0.0], np.cumsum(0.5 * h * (v[1:] + v[:-1]))])
+        t = h * np.arange(n)
+        record = slice(0, 2 * (self.tb.n_out - 1) * OVERSAMPLE + 1)
+        slope = np.polyfit(t[record], y[record], 1)[0]
+        v, y = v - slope, y - slope * t
+        return v[::2], (y - np.mean(y[record]))[::2]
+
     def output(self, kind: int, p: np.ndarray, n_sub: int,
                internal: bool = False) -> np.ndarray | tuple[np.ndarray, ...]:
-        """Noise-free recorded z'' (output rate), cached; with ``internal``, also z'', z, z'
-        at the internal rate (not cached)."""
+        """Noise-free recorded output (z'' or z, :attr:`channel`; output rate), cached;
+        with ``internal``, also z'', z, z' at the internal rate."""
         key = (int(kind), p.tobytes(), int(n_sub))
         if internal or key not in self._outputs:
             self.sims += 1
             acc, z, v = simulate(kind, p, self.grid, self.tb, n_sub)
-            self._outputs[key] = daq(acc, self.tb.n_out)
+            self._outputs[key] = daq(acc if self.channel == "acc" else z, self.tb.n_out)
             if internal:
                 return self._outputs[key], acc, z, v
         return self._outputs[key]
@@ -686,15 +761,16 @@ class Context:
     z_max: float          # largest |z| (m) over the simulated span
     abs_z: np.ndarray = field(repr=False)  # sorted |z| (m) over the simulated span
     record_s: float = 0.0  # time (s) of the record's last output sample
+    base_v0: float = 0.0   # the base's velocity y' at t = 0 (m/s, :attr:`_Run.base_motion`)
 
     @classmethod
     def of(cls, device: Device, fs: float, z: np.ndarray, v: np.ndarray,
-           window: slice) -> Context:
+           window: slice, base_v0: float = 0.0) -> Context:
         """From the baseline's internal-rate z, z' and the internal window after the lead-in
         (which ends at the record's last output sample)."""
         abs_z = np.sort(np.abs(z))
         return cls(device, fs, _rms(z[window]), _rms(v[window]), float(abs_z[-1]), abs_z,
-                   (window.stop - 1) / (OVERSAMPLE * fs))
+                   (window.stop - 1) / (OVERSAMPLE * fs), base_v0)
 
     def gap(self, quantile: float) -> float:
         """The |z| quantile (m) of the baseline motion (1: its largest |z|, never exceeded)."""
@@ -880,6 +956,18 @@ _CITE = {
                  "Procedures, 4th ed. Wiley (periodic contamination of measured data, power-"
                  "line pickup); Ewins, D.J. (2000) Modal Testing, 2nd ed. (mains hum in "
                  "transducer signals).",
+    "dead_zone": "Nordin, M., Gutman, P.-O. (2002) Controlling mechanical systems with "
+                 "backlash - a survey. Automatica 38(10):1633-1649 (the dead-zone model); "
+                 "Tao, G., Kokotovic, P.V. (1996) Adaptive Control of Systems with "
+                 "Actuator and Sensor Nonlinearities. Wiley (dead zones).",
+    "backlash": "Nordin, M., Gutman, P.-O. (2002) Controlling mechanical systems with backlash "
+                "- a survey. Automatica 38(10):1633-1649 (two inertias coupled through a "
+                "dead zone); contact damping from the restitution as Gilardi & "
+                "Sharf (2002), Mech. Mach. Theory 37(10).",
+    "ground_friction": "Marino, L., Cicirello, A. (2023) A switching Gaussian process latent "
+                       "force model for the identification of mechanical systems with a "
+                       "discontinuous nonlinearity. arXiv:2303.03858 (a base-excited frame "
+                       "whose friction contact is fixed to the ground).",
 }
 
 
@@ -927,6 +1015,53 @@ def _maxwell_slip() -> LiteratureScenario:
         "D_1 = F_c / k with k 1e3-1e6 N/m log-uniform (1 um..min(1 mm, 0.2 z_rms)), D_2 = r D_1 "
         "with r 3-10 log-uniform, first element's share a 0.3-0.7",
         draw, lambda ctx, sh: _SHARE, effect)
+
+
+def _backlash(ctx: Context, sh: dict, s: float) -> Effect:
+    """Gap g = s z_rms between the mass m and the screw side J = M - m; contact stiffness
+    k_b = mu (2 pi f_b)^2 on the reduced mass mu = m J / (m + J), c_b = 2 zeta_b sqrt(k_b mu),
+    zeta_b from the restitution e as :func:`_stop_kv`."""
+    d = ctx.device
+    mu = d.m * (d.M - d.m) / d.M
+    k_b = mu * (2.0 * np.pi * sh["contact_hz"]) ** 2
+    ln_e = np.log(sh["restitution"])
+    zeta = -ln_e / np.sqrt(np.pi ** 2 + ln_e ** 2)
+    return BACKLASH, [s * ctx.z_rms, k_b, 2.0 * zeta * np.sqrt(k_b * mu)], {}
+
+
+def _appended() -> list[LiteratureScenario]:
+    """The spring's dead zone, backlash and friction on the ground (issue 63), appended so that
+    the grid's earlier scenarios keep their places."""
+    S = LiteratureScenario
+    return [
+        S("spring_dead_zone", "dead zone", "F_spring = k dz(z, g) in place of k z, dz(z, g) = "
+          "z - g sgn z for |z| > g, else 0", (), ("end_stop", "backlash", "cubic_stiffness"),
+          "the main spring acts through a play of +-g (a dead zone in its mount): no restoring "
+          "force within the gap; no library term has it (end_stop adds a stiffness beyond a "
+          "gap, backlash couples the mass to the screw side, not to the spring)",
+          _CITE["dead_zone"], "g / z_max, 1e-6..0.5", "none",
+          lambda rng, ctx: {}, lambda ctx, sh: (1e-6, 0.5),
+          lambda ctx, sh, s: (SPRING_DEAD_ZONE, [s * ctx.z_max], {})),
+        S("backlash", "backlash", "m z'' = -m y'' - k z - F_b, J r'' = F_b - c r' - F_c S(r'/v_t)"
+          ", F_b = max(k_b dz(z - r, g) + c_b (z' - r'), 0) sgn(z - r) in contact, J = M - m",
+          ("backlash",), ("unmodelled_mode", "end_stop"),
+          "a play of +-g between the mass and the screw side (the nut's backlash), 2 DOF",
+          _CITE["backlash"], "g / z_rms, 1e-6..1",
+          "contact frequency on m J / (m + J) 0.5-2 fs (log-uniform); restitution 0.3-0.9",
+          lambda rng, ctx: {"contact_hz": _log_uniform(rng, 0.5 * ctx.fs, 2.0 * ctx.fs),
+                            "restitution": rng.uniform(0.3, 0.9)},
+          lambda ctx, sh: (1e-6, 1.0), _backlash),
+        S("ground_friction", "friction on the ground",
+          "F = (1 - s) F_c S(z'/v_t) + s F_c S((z' + y')/v_t)", ("coulomb_friction",),
+          ("sticking_friction", "stribeck_friction", "hysteresis"),
+          "a share s of the device's friction acts on the mass's absolute velocity (a contact "
+          "fixed to the ground); the sidecar is silent (no friction_on). Right only with the "
+          "diagnosis's topology 'ground' (base_disp inputs); with a force input the base is "
+          "the ground and the form is the baseline itself (not generated)",
+          _CITE["ground_friction"], "share s on the ground, 1e-5..1", "none",
+          lambda rng, ctx: {}, lambda ctx, sh: _SHARE,
+          lambda ctx, sh, s: (GROUND_FRICTION, [s], {"v_ref": ctx.base_v0})),
+    ]
 
 
 def _friction_scenarios() -> list[LiteratureScenario]:
@@ -1141,7 +1276,7 @@ def _scenarios() -> dict[str, LiteratureScenario]:
         lambda rng, ctx: {}, lambda ctx, sh: (0.0, 0.0), lambda ctx, sh, s: (NONE, [], {}))
     entries = (_friction_scenarios() + _stop_scenarios() + _spring_scenarios()
                + _structural_and_mass() + _damping() + [none] + _outside_library()
-               + [_maxwell_slip()])
+               + [_maxwell_slip()] + _appended())
     return {e.name: e for e in entries}
 
 
@@ -1154,7 +1289,8 @@ SCENARIOS: dict[str, LiteratureScenario] = _scenarios()
 _KIND_NAMES = ("none", "lugre", "dahl", "bouc_wen", "karnopp", "stribeck", "asymmetric",
                "stop_kelvin_voigt", "stop_power", "spring_power", "damper_power", "mount",
                "secondary_mode", "periodic_in_z", "spring_even", "friction_drift",
-               "sensor_line", "maxwell_slip")
+               "sensor_line", "maxwell_slip", "ground_friction", "spring_dead_zone",
+               "backlash")
 #: Names of the effect parameters p[E:] per kind (SI units).
 EFFECT_PARAMETERS: dict[int, tuple[str, ...]] = {
     NONE: (), LUGRE: ("share", "sigma0_N_per_m", "sigma1_N_s_per_m"),
@@ -1172,6 +1308,8 @@ EFFECT_PARAMETERS: dict[int, tuple[str, ...]] = {
     FRICTION_DRIFT: ("change_over_record", "t_centre_s", "record_s"),
     SENSOR_LINE: ("amplitude_m_per_s2", "frequency_hz", "phase_rad"),
     MAXWELL_SLIP: ("share", "first_element_share", "D1_m", "D2_m"),
+    GROUND_FRICTION: ("share_on_ground",), SPRING_DEAD_ZONE: ("gap_m",),
+    BACKLASH: ("gap_m", "k_b_N_per_m", "c_b_N_s_per_m"),
 }
 
 
@@ -1311,7 +1449,7 @@ def _calibrate(run: _Run, scen: LiteratureScenario, device: Device, rng: np.rand
     tb = run.tb
     n_sub = _initial_substeps(device, tb)
     base, _, z, v = run.output(NONE, device.params(), n_sub, internal=True)
-    ctx = Context.of(device, tb.fs, z, v, _internal_window(tb))
+    ctx = Context.of(device, tb.fs, z, v, _internal_window(tb), float(run.base_motion[0][0]))
     shape, s, draws = {}, None, 0
     if scen.name != "none":
         shape, s, draws = _draw_and_solve(run, scen, ctx, base, n_sub, rng, target)
@@ -1320,7 +1458,8 @@ def _calibrate(run: _Run, scen: LiteratureScenario, device: Device, rng: np.rand
         kind, p = effect_params(device, scen.effect(ctx, shape, 0.0 if s is None else s))
         change = _step_change(run, device, kind, p, n_sub) / noise_rms
         tol = KARNOPP_CONVERGENCE_TOL if kind == KARNOPP else CONVERGENCE_TOL
-        if change <= tol or 2 * n_sub > MAX_SUBSTEPS:
+        if change <= tol or 2 * n_sub > (MAX_SUBSTEPS_BACKLASH if kind == BACKLASH
+                                         else MAX_SUBSTEPS):
             break
         n_sub *= 2
         if s is not None:
@@ -1401,12 +1540,14 @@ def _atomic_write(path: Path, text: str) -> None:
 class GeneratedRecording:
     """A recording, its sidecar (the 'known' M, m, k) and its ground truth."""
 
-    recording: pd.DataFrame        # time (s), base_acc, rel_acc (m/s^2)
+    recording: pd.DataFrame        # time (s), input, output (base_acc, rel_acc by default)
     sidecar: dict[str, float]      # M (kg), m (kg), k (N/m) as weighed/measured
     truth: dict[str, Any]          # JSON-serialisable
-    contribution: np.ndarray = field(repr=False)      # c(t) (m/s^2), output rate
-    clean_rel_acc: np.ndarray = field(repr=False)     # noise-free rel_acc with the effect
-    baseline_rel_acc: np.ndarray = field(repr=False)  # noise-free rel_acc of the device
+    #: c(t), noise-free outputs with the effect and of the device, at the output rate, in the
+    #: output's unit (rel_acc m/s^2 or rel_disp m: the kind's output; names kept)
+    contribution: np.ndarray = field(repr=False)
+    clean_rel_acc: np.ndarray = field(repr=False)
+    baseline_rel_acc: np.ndarray = field(repr=False)
     #: the contribution as a model driven by the recorded base_acc produces it
     #: (:func:`recorded_input_contribution`)
     input_contribution: np.ndarray = field(repr=False)
@@ -1459,15 +1600,33 @@ def _record(run: _Run, cal: _Calibrated, noise: tuple[np.ndarray, np.ndarray],
                          "rel_acc": mass - base})
 
 
+#: Recording kinds, "input->output" (column names of ``harvester.data.recording``); the first,
+#: the paper's base-excited accelerometer pair, is the default.
+KINDS = ("base_acc->rel_acc", "base_disp->rel_disp", "base_disp->rel_acc", "force->rel_disp")
+#: Each channel's noise in the kinds after the first: its RMS in what the model takes of the
+#: channel (:data:`NOISE_ORDER`: y'' of base_disp, z' of rel_disp, the others as they are;
+#: derivatives spectral, up to PASSBAND x fs) as a share of that quantity's noise-free RMS
+#: (the output's over the baseline device), after the lead-in; the accelerometer pair's rel_acc
+#: noise was 5-40 % of its RMS at seed 0 (karnopp, maxwell_slip, none). A force's is 0.5 %
+#: (a load cell's): at 5 % the device's response to it was 7.9 x the displacement's noise
+#: floor on ``none`` (seed 20260501, 20 s) and the diagnosis read it as missing physics.
+#: ``generate``'s ``noise_scale`` multiplies them.
+NOISE_SHARES = {"base_disp": 0.05, "rel_disp": 0.05, "rel_acc": 0.05, "force": 5e-3}
+#: Time derivatives of a channel its noise share is stated in.
+NOISE_ORDER = {"base_disp": 2, "rel_disp": 1, "rel_acc": 0, "force": 0}
+
+
 def generate(name: str, seed: int, ratio: float = 0.5, duration_s: float = 40.0,
              fs: float = 256.0, noise_rel_acc: float = 0.09, lsb: float | None = None,
              friction_form: str = "tanh", shared_input_noise: bool = True,
-             sensor_resonance: tuple[float, float] | None = None) -> GeneratedRecording:
+             sensor_resonance: tuple[float, float] | None = None, kind: str = KINDS[0],
+             noise_scale: float = 1.0) -> GeneratedRecording:
     """A recording of a device drawn for ``seed`` with the scenario ``name``'s effect.
 
-    The effect's contribution to the recorded rel_acc has RMS = ratio x the rel_acc noise's
-    RMS (after a 1 s lead-in). ``noise_rel_acc`` (m/s^2): the rel_acc channel's noise RMS
-    (each accelerometer's is 1/sqrt(2) of it); ``lsb`` (m/s^2): quantisation step of both
+    The effect's contribution to the recorded output has RMS = ratio x the output channel's
+    noise RMS (after a 1 s lead-in). ``kind`` (:data:`KINDS`): what is recorded.
+    base_acc->rel_acc: ``noise_rel_acc`` (m/s^2) is the rel_acc channel's noise RMS (each
+    accelerometer's is 1/sqrt(2) of it); ``lsb`` (m/s^2): quantisation step of both
     channels, None for none. ``friction_form``: the device's smooth sign S ('tanh', the
     diagnosis's baseline law; 'atan', 'algebraic', or 'drawn' per seed); a form other than
     tanh is a second, unnamed departure from the baseline (its size is in the truth's
@@ -1479,15 +1638,30 @@ def generate(name: str, seed: int, ratio: float = 0.5, duration_s: float = 40.0,
     excitation and the effect are the same either way. ``sensor_resonance`` (f Hz, zeta): the
     mass accelerometer's own resonance (:func:`accelerometer`), on the output channel only, a
     second departure outside the device; the truth's ``sensor_resonance`` gives its change of
-    the recorded rel_acc over the noise RMS.
+    the recorded rel_acc over the noise RMS. The other kinds (:func:`_kind_recording`): each
+    channel has its own white noise through the DAQ, ``noise_scale`` x its
+    :data:`NOISE_SHARES` x its noise-free RMS (the output's over the baseline device); lsb,
+    sensor_resonance and shared_input_noise are the accelerometer pair's and are refused.
     """
-    if name not in SCENARIOS:
-        raise ValueError(f"unknown scenario {name!r}; known: {', '.join(SCENARIOS)}")
-    if duration_s <= 2.0 * LEAD_IN_S or ratio < 0.0 or noise_rel_acc <= 0.0:
-        raise ValueError("need duration_s > 2 s, ratio >= 0 and noise_rel_acc > 0")
+    _check_request(name, kind, duration_s, ratio, noise_rel_acc, noise_scale,
+                   lsb is not None or sensor_resonance is not None or not shared_input_noise)
     scen = SCENARIOS[name]
     rng_device, rng_excitation, rng_shape, rng_noise = _streams(name, seed)
     tb = TimeBase(fs, round(duration_s * fs))
+    rngs = (rng_device, rng_excitation, rng_shape, rng_noise)
+    if kind != KINDS[0]:
+        return _generate_kind(scen, seed, ratio, duration_s, tb, kind, noise_scale, rngs,
+                              noise_rel_acc, friction_form)
+    return _generate_pair(scen, seed, ratio, duration_s, tb, rngs, noise_rel_acc, lsb,
+                          friction_form, shared_input_noise, sensor_resonance)
+
+
+def _generate_pair(scen: LiteratureScenario, seed: int, ratio: float, duration_s: float,
+                   tb: TimeBase, rngs: tuple, noise_rel_acc: float, lsb: float | None,
+                   friction_form: str, shared_input_noise: bool,
+                   sensor_resonance: tuple[float, float] | None) -> GeneratedRecording:
+    """:func:`generate` for the accelerometer pair, base_acc -> rel_acc."""
+    rng_device, rng_excitation, rng_shape, rng_noise = rngs
     sensor = noise_rel_acc / np.sqrt(2.0)
     noise = (sensor_noise(rng_noise, sensor, tb.n_out), sensor_noise(rng_noise, sensor, tb.n_out))
     if not shared_input_noise:
@@ -1495,7 +1669,7 @@ def generate(name: str, seed: int, ratio: float = 0.5, duration_s: float = 40.0,
     noise_rms = _rms((noise[1] - noise[0])[tb.window])
     run, device, cal, device_draw = _calibrated_device(
         scen, tb, duration_s, (rng_device, rng_excitation, rng_shape), noise_rel_acc,
-        friction_form, ratio, noise_rms)
+        friction_form, ratio, lambda run, device: noise_rms)
     contribution = cal.with_effect - cal.baseline
     jac = sensitivities(run, device, cal.n_sub)
     truth = _truth(scen, seed, run, cal, contribution, jac, noise_rms, sensor, lsb, ratio)
@@ -1514,17 +1688,128 @@ def generate(name: str, seed: int, ratio: float = 0.5, duration_s: float = 40.0,
                               cal.baseline, driven)
 
 
+def _check_request(name: str, kind: str, duration_s: float, ratio: float,
+                   noise_rel_acc: float, noise_scale: float, pair_options: bool) -> None:
+    """ValueError naming what is wrong with a request to :func:`generate`."""
+    if name not in SCENARIOS:
+        raise ValueError(f"unknown scenario {name!r}; known: {', '.join(SCENARIOS)}")
+    if kind not in KINDS:
+        raise ValueError(f"unknown recording kind {kind!r}; known: {', '.join(KINDS)}")
+    if duration_s <= 2.0 * LEAD_IN_S or ratio < 0.0 or noise_rel_acc <= 0.0:
+        raise ValueError("need duration_s > 2 s, ratio >= 0 and noise_rel_acc > 0")
+    if kind != KINDS[0] and (pair_options or noise_scale <= 0.0):
+        raise ValueError(f"{kind}: lsb, sensor_resonance and shared_input_noise=False are the "
+                         "accelerometer pair's (base_acc->rel_acc); noise_scale must be > 0")
+    if kind.startswith("force") and name == "ground_friction":
+        raise ValueError("ground_friction with a force input: the base is fixed, so the "
+                         "ground is the base and the form is the baseline device itself")
+
+
+def _generate_kind(scen: LiteratureScenario, seed: int, ratio: float, duration_s: float,
+                   tb: TimeBase, kind: str, scale: float, rngs: tuple, noise_rel_acc: float,
+                   friction_form: str) -> GeneratedRecording:
+    """:func:`generate` for the kinds after the first (:func:`_kind_recording`)."""
+    unit = (sensor_noise(rngs[3], 1.0, tb.n_out), sensor_noise(rngs[3], 1.0, tb.n_out))
+    inp, out = kind.split("->")
+    channel = "acc" if out == "rel_acc" else "disp"
+    share = (scale * NOISE_SHARES[inp], scale * NOISE_SHARES[out])
+
+    def noise_of(run: _Run, device: Device) -> float:  # the output's realised noise RMS
+        base = run.output(NONE, device.params(), _initial_substeps(device, tb))
+        return _noise_scale(base, unit[1], NOISE_ORDER[out], share[1], tb) * _rms(
+            unit[1][tb.window])
+
+    run, device, cal, device_draw = _calibrated_device(
+        scen, tb, duration_s, rngs[:3], noise_rel_acc, friction_form, ratio, noise_of,
+        channel)
+    noise_rms = noise_of(run, device)
+    contribution = cal.with_effect - cal.baseline
+    jac = sensitivities(run, device, cal.n_sub)
+    truth = _truth(scen, seed, run, cal, contribution, jac, noise_rms, float("nan"), None,
+                   ratio)
+    recording, noise = _kind_recording(run, cal, kind, unit, share[0],
+                                       noise_rms / _rms(unit[1][tb.window]))
+    noise["noise_share"] = {inp: share[0], out: share[1]}
+    for key in ("noise_rms_rel_acc", "noise_rms_per_sensor"):
+        truth.pop(key)
+    truth["effect"]["device_draws"] = device_draw
+    if kind.startswith("force"):
+        truth["excitation"]["input"] = "force F = -m y'' on the mass (N), the base fixed"
+    truth.update(missing_force_truth(run, cal), **noise, recording_kind=kind,
+                 input_driven_to_clean_contribution=None, noise_rms_output=noise_rms)
+    sidecar = {"M": device.M, "m": device.m, "k": device.k}
+    return GeneratedRecording(recording, sidecar, truth, contribution, cal.with_effect,
+                              cal.baseline, contribution)
+
+
+def _kind_recording(run: _Run, cal: _Calibrated, kind: str, unit: tuple, share: float,
+                    out_scale: float) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """(recording, noise truth) of a kind after the first. Input: the base displacement y
+    (:attr:`_Run.base_motion`) or, with the base fixed, the force -m y'' on the mass (eq. 1
+    driven by F = -m y'' moves the mass as the base acceleration y'' does); output: z'' or z.
+    Each channel through the DAQ plus its own noise (``unit``, unit RMS, scaled: the input's
+    by :func:`_noise_scale` at ``share``, the output's by ``out_scale``)."""
+    tb = run.tb
+    _, acc, z, _ = run.output(cal.kind, cal.p, cal.n_sub, internal=True)
+    inp, out = kind.split("->")
+    clean = (daq(-cal.p[_MOSC] * run.base_internal(), tb.n_out) if inp == "force"
+             else _daq_moving(run.base_motion, tb))
+    in_scale = _noise_scale(clean, unit[0], NOISE_ORDER[inp], share, tb)
+    recorded_in = clean + in_scale * unit[0]
+    recorded_out = daq(acc if out == "rel_acc" else z, tb.n_out) + out_scale * unit[1]
+    frame = pd.DataFrame({"time": np.arange(tb.n_out) / tb.fs, inp: recorded_in,
+                          out: recorded_out})
+    return frame, {"noise_rms_input": in_scale * _rms(unit[0][tb.window]),
+                   "noise_relative_to": (
+                       "per channel, the noise-free RMS of what the model takes of it (y'' of "
+                       "base_disp, z' of rel_disp, the others as they are; the output's over "
+                       "the baseline device) after the lead-in; white through the DAQ's "
+                       "filter, independent")}
+
+
+def _spectral_rms(x: np.ndarray, order: int, tb: TimeBase) -> float:
+    """RMS after the lead-in (and before the last LEAD_IN_S) of the order-th derivative of x
+    (output rate; its end-to-end line removed, (i 2 pi f)^order up to PASSBAND x fs)."""
+    if order == 0:
+        return _rms(x[tb.window])
+    r = x - np.linspace(x[0], x[-1], x.size)
+    f = np.fft.rfftfreq(x.size, 1.0 / tb.fs)
+    d = np.fft.irfft(np.fft.rfft(r) * (2j * np.pi * f) ** order * (f <= PASSBAND * tb.fs),
+                     x.size)
+    return _rms(d[tb.window.start: x.size - tb.window.start])
+
+
+def _noise_scale(clean: np.ndarray, unit: np.ndarray, order: int, share: float,
+                 tb: TimeBase) -> float:
+    """The factor on ``unit`` noise that makes its order-th derivative's RMS ``share`` x the
+    clean channel's (:func:`_spectral_rms`)."""
+    return share * _spectral_rms(clean, order, tb) / _spectral_rms(unit, order, tb)
+
+
+def _daq_moving(base_motion: tuple[np.ndarray, np.ndarray], tb: TimeBase) -> np.ndarray:
+    """The base displacement y through the DAQ, the base having moved at its constant
+    starting velocity before t = 0 (not resting at 0, which :func:`daq` assumes: a step):
+    the line y(0) + y'(0) t passes the linear-phase, unit-gain filter unchanged."""
+    v, y = base_motion
+    line = y[0] + v[0] * tb.h_int * np.arange(y.size)
+    return daq(y - line, tb.n_out) + y[0] + v[0] * np.arange(tb.n_out) / tb.fs
+
+
 def _calibrated_device(scen: LiteratureScenario, tb: TimeBase, duration_s: float, rngs: tuple,
                        noise_rel_acc: float, friction_form: str, ratio: float,
-                       noise_rms: float) -> tuple[_Run, Device, _Calibrated, int]:
+                       noise_of: Callable[[_Run, Device], float], channel: str = "acc"
+                       ) -> tuple[_Run, Device, _Calibrated, int]:
     """(run, device, calibration, draws made): devices drawn (``rngs``: the device's, the
-    excitation's and the shape's streams) until one reaches the ratio, at most
-    MAX_DEVICE_DRAWS."""
+    excitation's and the shape's streams) until one reaches the ratio x ``noise_of`` (the
+    output's noise RMS for the run and device), at most MAX_DEVICE_DRAWS; ``channel``: the
+    recorded output (:class:`_Run`)."""
     rng_device, rng_excitation, rng_shape = rngs
     for device_draw in range(1, MAX_DEVICE_DRAWS + 1):
         device = draw_device(rng_device, noise_rel_acc, friction_form)
-        run = _Run(draw_excitation(rng_excitation, device, tb.period, duration_s, tb.fs), tb)
+        run = _Run(draw_excitation(rng_excitation, device, tb.period, duration_s, tb.fs), tb,
+                   channel)
         device = settle_v_t(run, device)
+        noise_rms = noise_of(run, device)
         try:
             cal = _calibrate(run, scen, device, rng_shape, ratio * noise_rms, noise_rms)
             return run, device, cal, device_draw
