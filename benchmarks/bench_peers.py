@@ -24,8 +24,8 @@ put in, the friction's form taken) and their confusion matrix (``grid.scoring``)
 ``--effects`` at seed 0 and the effect-free record at each of ``--free-seeds``
 (``--effects`` with no name: none), of each of ``--kinds`` (the generator's recording kinds,
 ``literature.KINDS``; default base_acc->rel_acc), ``--duration`` s each. ``--real``: the
-shipped real recordings too (the frame at 250 g and 450 g, the Silverbox; ``grid.recorded``: their truths and why), read from
-``--data`` (default data/public); their diagnosis is ``diagnosis.diagnose_recording``, the
+shipped real recordings too (the frame at 250 g and 450 g, the Silverbox; ``grid.recorded``:
+their truths and why), read from ``--data`` (default data/public); their diagnosis is ``diagnosis.diagnose_recording``, the
 command line's call on the file, against the study's linear baseline.
 
 ``--fast``: the diagnosis's ``DiagnosisSettings.fast`` (15 s fitted by TMCMC, one round, two
