@@ -209,7 +209,8 @@ def print_confusion(records) -> None:
           f"cut the search on {int(table['budget_cut'].sum())} of {len(table)}")
 
 
-def main(argv: list[str] | None = None) -> int:
+def parser() -> argparse.ArgumentParser:
+    """The command's options (module docstring)."""
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--set", type=Path, help="folder of recordings with truth files")
     p.add_argument("--make", type=Path, help="write literature-grid records into this folder")
@@ -233,23 +234,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--csv", type=Path, help="write the per-record rows here")
     p.add_argument("--confusion", action="store_true", help="the kept diagnoses' names per "
                    "record and their confusion matrix (grid.scoring), nothing run")
-    args = p.parse_args(argv)
-    clock = time.perf_counter()
-    if args.make:
-        make_set(args.make, args.effects, args.free_seeds, args.kinds, args.duration)
-        if args.real:
-            from harvester.grid.recorded import write_recorded_set
-            for csv in write_recorded_set(args.data, args.make):
-                print(f"made {csv.name}", flush=True)
-    if not args.set:
-        return 0
-    from harvester.grid.peers import diagnosis_row, peer_rows, read_set, summary
-    records = read_set(args.set)
-    if args.confusion:
-        print_confusion(records)
-        return 0
-    if not (args.skip_diagnosis or args.kept_only):
-        diagnose_all(records, args.fast, args.jobs)
+    return p
+
+
+def table_rows(records, args) -> list[dict]:
+    """Each record's rows, the diagnosis's and the peers', printed as they come."""
+    from harvester.grid.peers import diagnosis_row, peer_rows
     rows = []
     for rec in records:
         kept = rec.path.with_suffix(".diagnosis.json").is_file()
@@ -263,7 +253,28 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{rec.path.stem:28s} {r['tool']:22s} {rows[-1]['outcome']:12s} "
                   f"{' '.join(r['names'][:3]):40s} {r['heldout_nrmse'] or float('nan'):7.3f} "
                   f"{r['seconds']:8.2f} s", flush=True)
-    table = pd.DataFrame(rows)
+    return rows
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parser().parse_args(argv)
+    clock = time.perf_counter()
+    if args.make:
+        make_set(args.make, args.effects, args.free_seeds, args.kinds, args.duration)
+        if args.real:
+            from harvester.grid.recorded import write_recorded_set
+            for csv in write_recorded_set(args.data, args.make):
+                print(f"made {csv.name}", flush=True)
+    if not args.set:
+        return 0
+    from harvester.grid.peers import read_set, summary
+    records = read_set(args.set)
+    if args.confusion:
+        print_confusion(records)
+        return 0
+    if not (args.skip_diagnosis or args.kept_only):
+        diagnose_all(records, args.fast, args.jobs)
+    table = pd.DataFrame(table_rows(records, args))
     if args.csv:
         table.to_csv(args.csv, index=False)
     print()
