@@ -20,7 +20,9 @@ Priors:
   (the benchmark's alpha is half its small-amplitude stiffness)
 - d_bw: the loop's yield displacement 1 / (beta gamma), from a tenth of the RMS displacement
   (below it the element saturates at once: a friction of level k_bw d_bw / (1 + e_bw)) to ten
-  times it (above it the element is a linear spring over the record)
+  times it (above it the element is a linear spring over the record); a posterior piled at its
+  lower bound stands for friction (``limits``: sticking, then Coulomb), which the diagnosis
+  then samples in its place; on EMPS through the command line it had piled there alone
 - e_bw: delta / gamma, normal about 0 (the symmetric forms of the literature, |delta| <= gamma)
   with sd 1, within [-2, 2]: below -1 the loading branch hardens as exp(|1 + e_bw| x / d_bw),
   which the prior's edges let grow e^10 over ten RMS displacements (the rate bound assumes
@@ -87,6 +89,8 @@ TERM = Term(
              "s' = w - (|w| s + e_bw w |s|) / d_bw, x' = w",
     description="hysteretic spring (Bouc-Wen): a loop in the restoring force",
     force=force, state_rates=state_rates, rate_bound=rate_bound, alike=("hysteresis",),
+    # a yield displacement of nothing: the element holds, then slides at k_bw d_bw / (1 + e_bw)
+    limits=(("d_bw", "lower", "sticking_friction"), ("d_bw", "lower", "coulomb_friction")),
     probe=Probe("k_bw", lambda d: 0.1 * d.k,
                 shapes=lambda d: [{"d_bw": y * d.z, "e_bw": e}
                                   for y in PROBE_YIELD for e in PROBE_E]),
