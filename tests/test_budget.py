@@ -113,6 +113,28 @@ def test_a_candidate_stopped_mid_run_is_reported_not_judged(record, tmp_path, mo
     assert diag.missing == [] and not any(r["accepted"] for r in doc["rounds"])
 
 
+def test_a_candidate_whose_second_chain_is_stopped_is_judged_on_its_first(record, tmp_path,
+                                                                          monkeypatch):
+    """The candidate's second TMCMC chain stops at its first check: the first, finished,
+    decides (the record's friction is named), its evidence's error at least 1 nat, and a
+    note says it was judged on 1 of 2 chains."""
+    from harvester.diagnosis.name.fits import CUT_MIN_SE
+
+    def stop_second(self):
+        if self.deadline is not None and self.chain >= 1:
+            raise OutOfTime(self.chain, self.iteration, self.beta)
+    monkeypatch.setattr(TMCMC, "check_time", stop_second)
+    settings = DiagnosisSettings.fast(**{**OPTIONS, "chains": 2}, budget_s=1e6)
+    diag = diagnose_recording(record, "linear", settings=settings, out_dir=tmp_path)
+    doc = _document(diag, tmp_path)
+    validate_document(doc)
+    entry = next(c for c in doc["candidates"] if c["effect"] == "coulomb_friction")
+    assert entry["chains_cut"] == 1 and len(entry["log_evidence_chains"]) == 1
+    assert entry["log_evidence_se"] >= CUT_MIN_SE
+    assert diag.missing == ["coulomb_friction"], diag.headline
+    assert any("judged on 1 of 2 TMCMC chains" in n for n in doc["notes"]), doc["notes"]
+
+
 @pytest.mark.parametrize("asked, how", [(1, "not screened"), (2, "MAP fit stopped")])
 def test_a_screen_the_budget_cuts_leaves_its_candidates_unscreened(record, tmp_path,
                                                                   monkeypatch, asked, how):

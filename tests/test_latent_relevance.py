@@ -152,3 +152,39 @@ def test_an_own_forces_share_of_the_drive_is_over_its_own_span():
                            own_drive_N=own)
         assert isinstance(size, EffectSize) and size.share_of_drive == pytest.approx(0.1)
         assert size.own_share_of_drive == pytest.approx(0.3 / drive)
+
+
+def test_a_term_named_beside_another_is_sized_by_its_own_force():
+    """The Bouc-Wen benchmark's 40 s record named a mass error of 0.74 g beside the
+    hysteretic spring from one fit: their force together is the spring's (23.4 N, 47 % of
+    the drive), the mass error's own 0.036 N (0.07 %). It is detectable but negligible, not
+    a name of missing physics; the spring alone is sized in the headline. Two terms each
+    above the floor, or one without its own force, are left as they are."""
+    from types import SimpleNamespace
+
+    from harvester.diagnosis.size.relevance import (EffectSize, OwnForce, RelevanceFloor,
+                                                    negligible_beside)
+    from harvester.diagnosis.name.verdict import _named
+
+    def size(term, own_rms, drive=50.1):
+        own = None if own_rms is None else OwnForce((own_rms, own_rms, own_rms), (0, 0, 0),
+                                                    (own_rms, own_rms, own_rms), False)
+        return EffectSize(term, 23.4, 23.4 / drive, 0.98, None, None, False, RelevanceFloor(),
+                          own=own, drive_rms_N=drive)
+
+    spring, mass = size("hysteretic_spring", 22.6), size("inertia_error", 0.0356)
+    assert negligible_beside([spring, mass]) == ["inertia_error"]
+    assert mass.label == "detectable but negligible" and spring.label == "relevant"
+    assert mass.sentence().startswith("inertia_error: named beside hysteretic_spring; its "
+                                      "own force 0.0356 N RMS")
+    found = SimpleNamespace(named_fit=None, improved_fit=None, ties=[],
+                            missing=["hysteretic_spring"])
+    said = _named(found, SimpleNamespace(sizes=[spring, mass], together=None))
+    assert said == ("hysteretic_spring (its own force 22.6 N RMS, 95 % 22.6-22.6, 45.11% of "
+                    "the drive, relevant)")
+    assert negligible_beside([size("a", 22.6), size("b", 3.0)]) == []
+    assert negligible_beside([size("a", 22.6), size("b", None)]) == []
+    # the floor off: nothing is negligible
+    off = size("c", 0.01)
+    off.floor = RelevanceFloor(enabled=False)
+    assert negligible_beside([size("a", 22.6), off]) == []

@@ -24,6 +24,7 @@ from harvester.inference.reference import GaussianFactor, Reference, ScanFactor
 from harvester.inference.posterior import log_evidence
 from harvester.inference.tmcmc import (
     TMCMC,
+    OutOfTime,
     TMCMCError,
     compile_population_logp,
     fit_gaussian_mixture,
@@ -326,6 +327,27 @@ def test_run_tmcmc_statistics_and_progress_log(caplog):
     pm.sample_smc(100, kernel=TMCMC, model=model, chains=1, cores=1, random_seed=0,
                   progressbar=False, compute_convergence_checks=False, log=seen.append)
     assert any("accept=" in line for line in seen)
+
+
+def test_a_deadline_in_the_second_chain_keeps_the_first(monkeypatch):
+    """Chains run one after another: a deadline that stops the second returns the first,
+    the very chain the whole run gives (same seed), with the cut said; one that stops the
+    first raises."""
+    model = reference_model()
+    whole = run_tmcmc(model, draws=200, chains=2, seed=5)
+    monkeypatch.setattr(TMCMC, "past_deadline", lambda self: self.chain >= 1)
+    kept = run_tmcmc(model, draws=200, chains=2, seed=5, deadline=1.0)
+    assert kept.posterior.sizes["chain"] == 1
+    for name in ("mu", "log_sigma"):
+        np.testing.assert_array_equal(kept.posterior[name].values[0],
+                                      whole.posterior[name].values[0])
+    assert log_evidence(kept)[0] == log_evidence(whole)[0]
+    stats = kept.sample_stats
+    assert stats.attrs["chains_cut"] == 1 and "chain 1" in stats.attrs["cut"]
+    assert stats["log_evidence_se"].shape == (1,)
+    monkeypatch.setattr(TMCMC, "past_deadline", lambda self: True)
+    with pytest.raises(OutOfTime):
+        run_tmcmc(model, draws=200, chains=2, seed=5, deadline=1.0)
 
 
 def test_discrete_free_variables_are_refused():

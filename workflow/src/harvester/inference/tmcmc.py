@@ -112,6 +112,8 @@ __all__ = [
     "Reference",
     "TMCMC",
     "TMCMCError",
+    "FinishedChain",
+    "OutOfTime",
     "compile_population_logp",
     "mean_abs_correlation",
     "next_beta",
@@ -163,6 +165,20 @@ class OutOfTime(RuntimeError):
         self.chain, self.stage, self.beta = chain, stage, float(beta)
         super().__init__(f"TMCMC stopped at its deadline: chain {chain}, stage {stage}, "
                          f"beta {self.beta:.3g}")
+
+
+@dataclass(frozen=True)
+class FinishedChain:
+    """A chain that reached beta = 1 (``TMCMC(keep=...)``): its final population, its
+    per-stage statistics (one dict a stage, as ``TMCMC.sample_stats`` returns them), its
+    settings, and PyMC's layout of the model's variables in a particle."""
+
+    chain: int
+    tempered_posterior: np.ndarray
+    stats: list[dict]
+    settings: dict
+    var_info: dict
+    variables: list
 
 
 # --------------------------------------------------------------------------------------------
@@ -563,6 +579,10 @@ class TMCMC(SMC_KERNEL):
         checked before each stage and each Metropolis move (a caller's time budget); at
         beta = 1, whose evidence is complete, it only ends the last stage's settling moves
         once ``mcmc_steps`` are made. None: no deadline.
+    keep : list or None, default None
+        Where each chain that reaches beta = 1 is appended as a `FinishedChain` (its final
+        population, per-stage statistics and settings), so that `run_tmcmc` can return the
+        chains a deadline let finish when it stops a later one (chains run sequentially).
     log : logging.Logger or callable(str) or None, default None
         Where the per-stage progress line goes; None means the logger ``harvester.inference.tmcmc`` at
         INFO. A callable must be picklable by cloudpickle if ``cores > 1``. The chain number in
@@ -608,6 +628,7 @@ class TMCMC(SMC_KERNEL):
         resampling: str = "multinomial",
         reference: Reference | None = None,
         deadline: float | None = None,
+        keep: list | None = None,
         log: logging.Logger | Callable[[str], None] | None = None,
         **kwargs,
     ):
@@ -642,6 +663,8 @@ class TMCMC(SMC_KERNEL):
         self.mixture: GaussianMixture | None = None
         self.resampling = resampling
         self.deadline = deadline
+        self.keep = keep
+        self._chain_stats: list[dict] = []
         self.log = log
         model = modelcontext(kwargs.get("model"))
         self.population_logp_func = compile_population_logp(model, compile_kwargs)
@@ -688,6 +711,7 @@ class TMCMC(SMC_KERNEL):
         """
         self.chain += 1
         self._reset_stage_state()
+        self._chain_stats = []
         self.proposal_scale = self.initial_scale
         init = self.start if self.start else self.initialize_population()
         population = [
@@ -926,6 +950,11 @@ class TMCMC(SMC_KERNEL):
         }
         self.n_evals = 0
         self._stage_clock = now
+        self._chain_stats.append(stats)
+        if self.beta >= 1.0 and self.keep is not None:
+            self.keep.append(FinishedChain(self.chain, self.tempered_posterior.copy(),
+                                           list(self._chain_stats), self.sample_settings(),
+                                           self.var_info, list(self.variables)))
         self._say(
             f"TMCMC chain {self.chain} stage {self.iteration}: beta={self.beta:.4g} "
             f"(cov(w)={self.weights_cov:.2f}, ESS={self.ess:.0f}/{self.draws}), "
@@ -1028,21 +1057,50 @@ def run_tmcmc(
     rates, likelihood evaluations and wall times; numeric only, so it can be saved to netCDF.
     """
     start = time.perf_counter()
+    keep = [] if kernel_kwargs.get("deadline") is not None and cores == 1 and chains > 1 \
+        else None
+    cut = None
     with warnings.catch_warnings(), pytensor.config.change_flags(mode=COMPILE_MODE):
         # PyMC packs SMC stats as (1 chain, n chains) arrays; tidy_sample_stats redoes them.
         warnings.filterwarnings("ignore", message="More chains", category=UserWarning)
-        idata = pm.sample_smc(
-            draws=draws,
-            kernel=TMCMC,
-            model=model,
-            chains=chains,
-            cores=cores,
-            random_seed=seed,
-            progressbar=progressbar,
-            compute_convergence_checks=False,
-            idata_kwargs=idata_kwargs,
-            **kernel_kwargs,
-        )
+        try:
+            idata = pm.sample_smc(
+                draws=draws,
+                kernel=TMCMC,
+                model=model,
+                chains=chains,
+                cores=cores,
+                random_seed=seed,
+                progressbar=progressbar,
+                compute_convergence_checks=False,
+                idata_kwargs=idata_kwargs,
+                **({} if keep is None else {"keep": keep}),
+                **kernel_kwargs,
+            )
+        except OutOfTime as stop:
+            if not keep:
+                raise
+            cut = stop
+            idata = finished_idata(keep, model, idata_kwargs, time.perf_counter() - start)
     wall_time = time.perf_counter() - start
-    idata.sample_stats = tidy_sample_stats(idata.sample_stats, chains, wall_time)
+    done = chains if cut is None else len(keep)
+    idata.sample_stats = tidy_sample_stats(idata.sample_stats, done, wall_time)
+    if cut is not None:
+        idata.sample_stats.attrs.update(chains_cut=chains - done, cut=str(cut),
+                                        cut_stage=cut.stage, cut_beta=cut.beta)
+        logger.warning("%s; kept the %d chain(s) that finished before it", cut, done)
+    return idata
+
+
+def finished_idata(keep: Sequence[FinishedChain], model: Model, idata_kwargs: dict | None,
+                   seconds: float) -> az.InferenceData:
+    """InferenceData of the chains a deadline let finish (``TMCMC(keep=...)``), built as
+    ``pm.sample_smc`` builds it from its chains (PyMC 5.28's own helpers)."""
+    from pymc.backends.base import MultiTrace
+    from pymc.smc.sampling import _build_trace_from_kernel_state, _save_sample_stats
+    traces = [_build_trace_from_kernel_state(k.tempered_posterior, k.var_info, k.variables, i,
+                                             model) for i, k in enumerate(keep)]
+    stats = [{name: [row[name] for row in k.stats] for name in k.stats[0]} for k in keep]
+    _, idata = _save_sample_stats([dict(k.settings) for k in keep], stats, len(keep),
+                                  MultiTrace(traces), True, seconds, idata_kwargs, model)
     return idata

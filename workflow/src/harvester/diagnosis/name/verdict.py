@@ -31,7 +31,7 @@ from harvester.diagnosis.name.fits import ModelFit
 from harvester.diagnosis.detect.scores import Detection
 from harvester.diagnosis.detect.floor import Floor
 from harvester.diagnosis.size.missing_force import MissingForce
-from harvester.diagnosis.size.relevance import MIN_SHARE_EXPLAINED, OwnForce
+from harvester.diagnosis.size.relevance import MIN_SHARE_EXPLAINED, OwnForce, negligible_beside
 from harvester.diagnosis.name.rounds import Round, rough_rivals
 from harvester.diagnosis.name.separate import Separation, separations
 from harvester.diagnosis.size.shapes import beyond_uncertainty, has_its_shape, library_terms
@@ -231,6 +231,8 @@ def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings
     refused = []
     for rnd in rounds:
         for r in rnd.confirmed:
+            if r.fit.cut_sentence():
+                notes.append(r.fit.cut_sentence())
             if r.at_prior_edge:
                 notes.append(f"{r.effect}: the posterior of {', '.join(r.at_prior_edge)} piles "
                              "against its prior's bound; the candidate is not trusted")
@@ -348,6 +350,8 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
     limit = settings.floor_ratio
     above, within = fit.above(limit), fit.within(limit)
     sizes = missing.sizes if missing is not None else []
+    beside = negligible_beside(sizes)
+    found = replace(found, missing=[e for e in found.missing if e not in beside])
     little = explains_little(sizes, fit.library_share())
     relevant = not sizes or any(not s.negligible and not s.little for s in sizes)
     shown = mismatch_shown(fit, missing)
@@ -451,7 +455,7 @@ def _named(found: Conclusion, missing: MissingForce | None, units: Units = SI) -
     fit = found.named_fit or found.improved_fit
     groups = [" / ".join(g) for g in [[_level(e, fit, units)] for e in found.missing]
               + [t.effects for t in found.ties]]
-    sizes = missing.sizes if missing is not None else []
+    sizes = [s for s in missing.sizes if not s.beside] if missing is not None else []
     if not sizes:
         return ", ".join(groups)
     s, force = sizes[0], units.label("force")
