@@ -380,3 +380,13 @@ def test_literature_generator_writes_a_scenario_the_grid_scores(tmp_path):
     assert truth["refit_unabsorbed_to_noise"] > 0.0
     with pytest.raises(ValueError, match="generator"):
         make_scenario_files("mine", "duffing", 0.5, 0, {}, {}, {}, csv, js)
+
+
+def test_a_name_of_the_same_physics_in_another_form_counts():
+    """The literature grid's Bouc-Wen friction lists hysteresis: the hysteretic spring (Bouc-Wen
+    in the spring, ``alike`` hysteresis) names it too; Coulomb friction's sticking form names
+    Coulomb friction; configured names are taken as they are."""
+    names = det.accepted_names("bouc_wen", truth={"correct_names": ["hysteresis"]})
+    assert {"hysteresis", "hysteretic_spring"} <= names and "cubic_stiffness" not in names
+    assert "sticking_friction" in det.accepted_names("coulomb_friction")
+    assert det.accepted_names("coulomb_friction", accepted={}) == {"coulomb_friction"}

@@ -6,7 +6,8 @@ into the detection table, the confusion matrix and the false-alarm rate.
 
 Scoring one scenario whose true effect is e. The correct names are the truth's own
 ``correct_names`` where the generator states them (the literature generator), else e and the
-names :data:`ACCEPTED` declares equivalent. Each scenario has one ``outcome``:
+names :data:`ACCEPTED` declares equivalent; with each, the library's terms of the same physics in
+another form (``Term.alike``). Each scenario has one ``outcome``:
 ``named`` (the first effect named alone is correct), ``tied`` (nothing named alone, and a tie
 the diagnosis reported, effects it could not tell apart, holds a correct name), ``wrong`` (the
 first effect named alone is not correct, or every tie lacks a correct name: the diagnosis said
@@ -147,11 +148,19 @@ def wilson_interval(k: int | np.ndarray, n: int | np.ndarray, level: float = 0.9
 def accepted_names(effect: str, accepted: Mapping[str, Iterable[str]] | None = None,
                    truth: Mapping[str, Any] | None = None) -> set[str]:
     """The names that count as naming ``effect``: the truth's ``correct_names`` if it states
-    them, else the effect and its :data:`ACCEPTED` equivalents."""
+    them, else the effect and its :data:`ACCEPTED` equivalents; by default (``accepted``
+    None) with every library term that describes the same physics in another form
+    (``Term.alike``, ``model.terms.same_physics``: Dahl's hysteresis and the hysteretic
+    spring, a sliding law and its sticking form)."""
     if truth is not None and truth.get("correct_names"):
-        return set(truth["correct_names"])
-    acc = ACCEPTED if accepted is None else accepted
-    return {effect, *acc.get(effect, ())}
+        names = set(truth["correct_names"])
+    else:
+        names = {effect, *(ACCEPTED if accepted is None else accepted).get(effect, ())}
+    if accepted is not None:
+        return names
+    from harvester.model.terms import TERMS, same_physics
+    known = [n for n in names if n in TERMS]
+    return names | {t for t in TERMS for n in known if same_physics(t, n)}
 
 
 def outcome(diagnosis: Mapping[str, Any], correct: set[str]) -> str:
