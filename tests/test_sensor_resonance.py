@@ -141,3 +141,36 @@ def test_a_reading_without_a_resonance_rules_the_sensor_out(device, monkeypatch)
                                  ConfirmSettings(), accepted=False)
     assert best.conclusion == "device"
     assert best.sentence().startswith("the mismatch is not the output sensor's")
+
+
+def test_a_mode_above_the_likelihoods_band_is_not_named():
+    """confirm.judge: a mode with the evidence to be accepted whose frequency lies above the
+    band the likelihood compares (the base_disp -> rel_acc records' 83-109 Hz above 81.9 Hz)
+    is not named, said so, and leaves the round's top to the next; one inside it is named."""
+    from types import SimpleNamespace
+
+    from harvester.diagnosis.name.confirm import ConfirmSettings, judge, skip_reason
+    from harvester.inference.priors import PriorSpec
+    from harvester.model.structures import structure as named_structure
+    s = named_structure("tanh+unmodelled_mode")
+    names = list(s.free_parameters) + ["sigma"]
+    priors = {n: PriorSpec(n, 0.0, 1e3, "-", lower=-np.inf) for n in s.free_parameters}
+
+    def fit(log_evidence, f_mode):
+        rows = np.full((200, len(names)), 0.5)
+        rows[:, names.index("f_mode")] = np.random.default_rng(1).normal(f_mode, 1.5, 200)
+        return SimpleNamespace(log_evidence=log_evidence, log_evidence_se=0.05, names=names,
+                               priors=priors, samples=rows, structure=s,
+                               problem=SimpleNamespace(known={"M": 1.0, "m": 1.0},
+                                                       band_hz=81.92))
+
+    base, cs = fit(0.0, 10.0), ConfirmSettings()
+    above = judge("unmodelled_mode", fit(60.0, 85.4), base, cs)
+    assert not above.accepted and set(above.beyond_band) == {"f_mode"}
+    assert above.at_limit == {"f_mode": "upper"} and above.unshown
+    assert "above the 81.9 Hz band the likelihood compares" in above.unresolved_sentence()
+    inside = judge("unmodelled_mode", fit(60.0, 18.2), base, cs)
+    assert inside.accepted and not inside.beyond_band
+    screened = SimpleNamespace(failed=False, pulled={}, bound=47.0,
+                               importance_ceiling=lambda sigmas: None)
+    assert skip_reason(screened, [above], cs, 1) is None  # not counted in the round's top

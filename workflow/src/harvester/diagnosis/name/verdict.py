@@ -231,12 +231,13 @@ def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings
     refused = []
     for rnd in rounds:
         for r in rnd.confirmed:
-            if r.fit.cut_sentence():
-                notes.append(r.fit.cut_sentence())
+            cut = r.fit.cut_sentence() if r.fit is not None else None
+            if cut:
+                notes.append(cut)
             if r.at_prior_edge:
                 notes.append(f"{r.effect}: the posterior of {', '.join(r.at_prior_edge)} piles "
                              "against its prior's bound; the candidate is not trusted")
-            if r.unresolved:
+            if r.unshown:
                 notes.append(f"{r.unresolved_sentence()} ({r.effect} gained "
                              f"{r.delta_log_evidence:+.1f} nats)")
             if r.refused_for_device:  # the headline says the furthest out, the notes all

@@ -172,6 +172,9 @@ class Term:
     to be its physics (a pre-sliding displacement): where the posterior puts one below the
     smallest displacement the record tells from its noise, the term is taken at that
     parameter's lower limit (``limits``), not named (``diagnosis.name.confirm.unresolved``).
+    ``in_band``: parameters that are frequencies (Hz) of a resonance the record must show:
+    where the posterior puts one above the band the likelihood compares, the record holds no
+    peak of it and the term is not named (``diagnosis.name.confirm.beyond_band``).
     ``static`` (a ``stick`` term): its share of the holding level (N), a function of its
     parameters. ``transition`` (a ``stick`` term whose law changes fast at low speed, a
     Stribeck decay): (speed, slope) = transition(*params), the speed (m/s) below which the
@@ -198,6 +201,7 @@ class Term:
     alike: tuple[str, ...] = ()
     limits: tuple[tuple[str, str, str], ...] = ()
     resolved: tuple[str, ...] = ()
+    in_band: tuple[str, ...] = ()
     restates: tuple[str, ...] = ()
     nameable: bool = True
     device: Callable[[Mapping], dict] | None = None
@@ -287,6 +291,8 @@ def check_term(t: Term) -> None:
     names = [p.name for p in t.parameters]
     if not set(t.resolved) <= {p.name for p in t.parameters if p.unit == "m"}:
         problems.append(f"resolved {t.resolved}: parameters of the term in metres")
+    if not set(t.in_band) <= {p.name for p in t.parameters if p.unit == "Hz"}:
+        problems.append(f"in_band {t.in_band}: parameters of the term in Hz")
     for parameter, side, other in t.limits:
         if parameter not in names or side not in ("lower", "upper") or other == t.name:
             problems.append(f"limit ({parameter}, {side}, {other}): a parameter of the term, "

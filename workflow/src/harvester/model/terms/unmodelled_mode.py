@@ -90,4 +90,4 @@ TERM = Term(
                                   for z in PROBE_DAMPING for b in (1.0, 0.0)
                                   for f in _frequency_grid(d)],
                 start_shape="f_mode"),
-    source=__file__)
+    in_band=("f_mode",), source=__file__)
