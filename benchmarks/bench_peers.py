@@ -162,7 +162,8 @@ def confusion(records) -> tuple[pd.DataFrame, pd.DataFrame]:
     beside the record, its recording kind, the names given, whether a mass error
     (inertia_error) was named where none was put in, the friction's form taken and whether
     the time budget cut the search for names; friction
-    put on the ground is named right only with the form "ground". The matrix is
+    put on the ground is named right by ``ground_friction``, or by a friction law with the
+    form "ground". The matrix is
     ``grid.scoring.confusion_matrix`` of the rows (true scenario x first name)."""
     from harvester.grid.scoring import confusion_matrix, score
     rows = []
@@ -171,10 +172,16 @@ def confusion(records) -> tuple[pd.DataFrame, pd.DataFrame]:
         if not kept.is_file():
             continue
         d = json.loads(kept.read_text())
-        row = score({"effect": rec.path.stem, "seed": 0, **rec.truth}, d)
-        missing, form = list(d.get("missing") or []), _topology(d)
         lit = rec.truth.get("literature") or {}
-        if (lit.get("effect") or {}).get("kind") == "ground_friction" and form != "ground" \
+        ground = (lit.get("effect") or {}).get("kind") == "ground_friction"
+        truth = {"effect": rec.path.stem, "seed": 0, **rec.truth}
+        if ground:  # the library's term on the ground names it in any form
+            truth["correct_names"] = sorted({*truth.get("correct_names", ()),
+                                             "ground_friction"})
+        row = score(truth, d)
+        missing, form = list(d.get("missing") or []), _topology(d)
+        named = missing[:1] or [e for t in d.get("ties") or [] for e in t.get("effects", [])]
+        if ground and form != "ground" and "ground_friction" not in named \
                 and row["outcome"] in ("named", "tied"):
             row["outcome"] = "wrong"
         rows.append({**row, "record": rec.path.stem,

@@ -19,7 +19,7 @@ from scipy.integrate import solve_ivp
 LIBRARY_TERMS = {"coulomb_friction", "tanh_friction", "stribeck_friction", "asymmetric_friction",
                  "quadratic_damping", "cubic_stiffness", "end_stop", "backlash", "hysteresis",
                  "unmodelled_mode", "inertia_error", "offset_force", "sticking_friction",
-                 "sticking_stribeck"}
+                 "sticking_stribeck", "ground_friction", "hysteretic_spring"}
 NOISE = 0.09
 FS = 256.0
 

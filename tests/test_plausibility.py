@@ -234,12 +234,15 @@ def test_a_mass_error_is_no_candidate_where_the_baseline_identifies_the_masses()
     from harvester.diagnosis import DiagnosisSettings
     from harvester.diagnosis.prepare.redundant import redundant_terms, without_redundant
 
-    assert set(redundant_terms({}, force_input=True)) == {"inertia_error"}
-    assert redundant_terms({"M": 95.0}, force_input=True) == {}
+    # friction on the ground is the baseline's own with a force input (the base is fixed)
+    assert set(redundant_terms({}, force_input=True)) == {"inertia_error", "ground_friction"}
+    assert set(redundant_terms({"M": 95.0}, force_input=True)) == {"ground_friction"}
     assert set(redundant_terms({"k": 1e3}, force_input=False)) == {"inertia_error"}
     assert redundant_terms({"m": 3.0}, force_input=False) == {}  # m is stated: a payload error
     settings, notes = without_redundant(DiagnosisSettings(), {"m": 0.0}, force_input=True)
     assert "inertia_error" not in settings.candidates and "cubic_stiffness" in settings.candidates
-    assert len(notes) == 1 and "restate M" in notes[0] and "give M" in notes[0]
+    assert "ground_friction" not in settings.candidates
+    assert len(notes) == 2 and "restate M" in " ".join(notes) and "give M" in " ".join(notes)
+    assert any("the base is fixed" in n for n in notes)
     chosen = DiagnosisSettings(candidates=("cubic_stiffness",))
     assert without_redundant(chosen, {}, force_input=True) == (chosen, [])

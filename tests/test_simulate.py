@@ -132,6 +132,7 @@ TERM_PARAMS = {
     "periodic_force": [3.0, 1.0, 0.005],
     "sticking_friction": [8.0],
     "sticking_stribeck": [3.0, 0.02, 2.0],
+    "ground_friction": [6.0],
 }
 
 
@@ -370,3 +371,40 @@ def test_acquired_gives_a_record_the_acquisitions_filter():
     same = np.sqrt(np.mean((acquired(point, DT, 4) - over)[inner] ** 2))
     assert same < 0.03 * plain
     assert np.array_equal(acquired(point, DT, 1), point)
+
+
+def test_friction_on_the_ground_follows_a_reference_solution():
+    """A ``ground`` term sees the mass's absolute velocity z' + y', y' integrated from the
+    recorded y'' (``simulate.base_velocity``): on a base moving as A sin(w t) (y'(0) = A w,
+    not at rest) the kernel follows LSODA at rtol 1e-10 with the analytic y' to 2e-4 of the
+    motion's size; with a force input it is Coulomb friction (the base is the ground); its
+    force along the path (``term_forces``) is its law at that velocity."""
+    from scipy.integrate import solve_ivp
+
+    from harvester.model.term_forces import term_force
+    from harvester.model.terms import term
+    M, m, k, c, F = 2.0, 1.5, 800.0, 3.0, 0.8
+    dt, A, w = 1.0 / 512.0, 0.004, 2.0 * np.pi * 3.0
+    t = np.arange(0.0, 8.0, dt)
+    ydd = -A * w**2 * np.sin(w * t)
+
+    def rhs(tt, x):
+        y_dot = A * w * np.cos(w * tt)
+        return [x[1], (m * A * w**2 * np.sin(w * tt) - c * x[1] - k * x[0]
+                       - F * np.tanh((x[1] + y_dot) / 1e-3)) / M]
+
+    ref = solve_ivp(rhs, (0.0, t[-1]), [0.0, 0.0], t_eval=t, rtol=1e-10, atol=1e-13,
+                    method="LSODA").y[0]
+    lay = Layout.of(["ground_friction"])
+    sim = simulate(lay, np.array([[M, m, k, c, F]]), ydd, dt)
+    assert np.max(np.abs(sim.rel_disp[0] - ref)) < 5e-4 * np.max(np.abs(ref))
+    force = np.sin(w * t)
+    on_ground = simulate(lay, np.array([[M, m, k, c, F]]), force, dt, force_input=True)
+    coulomb = simulate(Layout.of(["coulomb_friction"]), np.array([[M, m, k, c, F]]), force, dt,
+                       force_input=True)
+    np.testing.assert_allclose(on_ground.rel_disp, coulomb.rel_disp, atol=1e-15)
+    values = dict(zip(lay.parameter_names, [M, m, k, c, F]))
+    f = term_force(term("ground_friction"), values, sim.rel_disp, sim.rel_vel, sim.rel_acc,
+                   ydd, dt)
+    x_dot = sim.rel_vel[0] + A * w * np.cos(w * t)
+    assert np.max(np.abs(f[0] - F * np.tanh(x_dot / 1e-3))) < 0.1 * F

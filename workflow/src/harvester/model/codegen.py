@@ -29,8 +29,10 @@ in a pool of threads, each block followed at once by its acquisition (compiled o
 structure in ``harvester.model.acquisition``), so a new structure compiles only ``rhs`` and
 ``integrate`` (about a second).
 
-Drivers: ``base`` (input the base acceleration y'', drive -m y''), ``force`` (a force on the
-mass, base fixed), ``servo`` (a digital position loop computes the force at every sample from
+Drivers: ``base`` (input the base acceleration y'', drive -m y''; for a structure with a
+``ground`` term the input is complex, y'' + 1j y', so that the base velocity is interpolated
+with it through every integrator unchanged), ``force`` (a force on the mass, base fixed),
+``servo`` (a digital position loop computes the force at every sample from
 the simulated position, held over the sample: the EMPS drive).
 
 The module's source is written to a cache directory (``HARVESTER_CACHE`` or
@@ -102,6 +104,12 @@ def turning_point(w0, w1, dx, h):
             + dx * s * s * (3.0 - 2.0 * s))
 
 
+def has_ground(terms) -> bool:
+    """Whether a structure holds a term on the mass's absolute velocity (``ground``)."""
+    return any(term(t).kind == "ground" if isinstance(t, str) else t.kind == "ground"
+               for t in terms)
+
+
 def _names(terms: tuple[Term, ...]) -> tuple[list[str], list[str]]:
     """(parameter names, state names) of a structure in layout order."""
     params = ["M", "m", "k", "c_m"] + [p for t in terms for p in t.parameter_names]
@@ -127,10 +135,13 @@ def _rhs_source(terms: tuple[Term, ...], driver: str) -> str:
     for i, t in enumerate(terms):
         if t.masses is not None:
             lines.append(f"    _M, _m = _masses{i}(_M, _m, {args[i]})")
-    if driver == "base":
+    if driver == "base" and has_ground(terms):  # _u = y'' + 1j y' (module docstring)
+        lines += ["    _drive = -_m * _u.real", "    _yb = _u.real", "    _vb = _u.imag"]
+    elif driver == "base":
         lines += ["    _drive = -_m * _u", "    _yb = _u"]
-    else:
-        lines += ["    _drive = _u", "    _yb = 0.0"]
+    else:  # the base is fixed: the ground is the base
+        lines += ["    _drive = _u", "    _yb = 0.0"] + (["    _vb = 0.0"] if has_ground(terms)
+                                                       else [])
     coupling = [i for i, t in enumerate(terms) if t.kind == "coupling"]
     lines.append(f"    _w = v - {state_of[coupling[0]][1]}" if coupling else "    _w = v")
     lines += ["    _f_screw = c_m * _w", "    _f_mass = k * z", "    _f_mode = 0.0"]
@@ -140,6 +151,8 @@ def _rhs_source(terms: tuple[Term, ...], driver: str) -> str:
             lines.append(f"    _f_screw += _force{i}(_w, {st}{args[i]})")
         elif t.kind == "mass":
             lines.append(f"    _f_mass += _force{i}(z, {args[i]})")
+        elif t.kind == "ground":
+            lines.append(f"    _f_mass += _force{i}(v + _vb, {args[i]})")
         elif t.kind == "mode":
             lines.append(f"    _f_mode += _force{i}({st}{args[i]})")
     derivs: dict[str, str] = {}

@@ -7,6 +7,8 @@ left-hand side of eq. (1) with the stated masses M and m:
              path from 0 (``displacement_update`` where the term has one, else its
              ``state_rates``)
 ``mass``     X = force(z; params)
+``ground``   X = force(z' + y'; params), y' the base velocity of the path's y''
+             (``simulate.base_velocity``; zeros for a force input, whose y'' is zeros)
 ``inertia``  (M, m) -> (M', m') = masses(M, m; params): X = (M' - M) z'' + (m' - m) y''
 ``mode``     states (u, u') driven by the path's z'' and y'' (RK4 with the acceleration
              linear in a step); X = -force(u, u'; params) + (M' - M) z'' + (m' - m) y''
@@ -28,6 +30,7 @@ import numba as nb
 import numpy as np
 
 from harvester.model.codegen import compiled
+from harvester.model.simulate import base_velocity
 from harvester.model.structures import Layout
 from harvester.model.terms import Term
 
@@ -145,6 +148,9 @@ def term_force(t: Term, values: Mapping[str, float], z: np.ndarray, v: np.ndarra
     yb = np.asarray(yb, dtype=float)
     if t.kind == "mass":
         return _stateless(compiled(t.name, "force"), z, params)
+    if t.kind == "ground":
+        vb = base_velocity(yb, dt) if np.any(yb) else np.zeros_like(yb)
+        return _stateless(compiled(t.name, "force"), v + vb[None, :], params)
     if t.kind == "screw" and t.n_states == 0:
         return _stateless(compiled(t.name, "force"), v, params)
     if t.kind == "screw" and t.displacement_update is not None:

@@ -55,7 +55,7 @@ mains_hum               rel_acc + A sin(2 pi 50|60 Hz t + phi)      -- (unmodell
 maxwell_slip            (1-s) F_dev + s 2 Maxwell-slip elements     hysteresis, sticking (coulomb)
 spring_dead_zone        k dz(z, g) in place of k z, g = s z_max     -- (end_stop, backlash)
 backlash                2 DOF: m, J = M - m through a play +-g      backlash (mode, end_stop)
-ground_friction         (1-s) F_dev + s F_c S((z' + y')/v_t)        coulomb* (sticking, ...)
+ground_friction         (1-s) F_dev + s F_c S((z' + y')/v_t)        ground, coulomb* (sticking)
 ======================  ==========================================  =========================
 
 The last three were added after Maxwell-slip (issue 63). A dead zone in the main spring
@@ -65,8 +65,10 @@ carries the spring, the screw side J = M - m the damping and friction, coupled t
 Kelvin-Voigt contact beyond +-g. Friction on the ground (a contact fixed to the frame, as in
 Marino and Cicirello 2023) moves a share s to the mass's absolute velocity; the sidecar is
 silent about ``friction_on``. *A friction name is right only where the diagnosis also takes
-the topology "ground" (base_disp inputs); with a force input the base is the ground and the
-form is the baseline itself (refused), with base_acc y' is the band-limited integral of y''.
+the topology "ground" (base_disp inputs); ``ground_friction``, the library's term on the
+mass's absolute velocity beside the base's friction, names it on any base input. With a force
+input the base is the ground and the form is the baseline itself (refused); with base_acc y'
+is the band-limited integral of y''.
 
 The four after the effect-free one are outside the library (no correct name): a force
 periodic in the displacement (a generator's cogging through the screw), an even spring, a
@@ -1052,7 +1054,8 @@ def _appended() -> list[LiteratureScenario]:
                             "restitution": rng.uniform(0.3, 0.9)},
           lambda ctx, sh: (1e-6, 1.0), _backlash),
         S("ground_friction", "friction on the ground",
-          "F = (1 - s) F_c S(z'/v_t) + s F_c S((z' + y')/v_t)", ("coulomb_friction",),
+          "F = (1 - s) F_c S(z'/v_t) + s F_c S((z' + y')/v_t)",
+          ("ground_friction", "coulomb_friction"),
           ("sticking_friction", "stribeck_friction", "hysteresis"),
           "a share s of the device's friction acts on the mass's absolute velocity (a contact "
           "fixed to the ground); the sidecar is silent (no friction_on). Right only with the "

@@ -9,6 +9,12 @@ command line (M from the FRF, 84.8 kg) such a term was named with dM = +135 kg b
 offset force, a mass error on a device whose mass nobody stated. A term restates the
 quantities of its ``Term.restates``; m counts only where the input is a base motion (the drive
 -m y''), since a force input does not involve it.
+
+Friction on the ground (a ``ground`` term, on the mass's absolute velocity) is the baseline's
+own friction where the input is a force: the base is fixed, so the ground is the base. A
+record rewritten with its friction on the ground (the sidecar's ``friction_on: ground`` or
+the diagnosis's choice, ``topology``) is driven by a force too: its friction is all on the
+ground already.
 """
 
 from __future__ import annotations
@@ -36,6 +42,10 @@ def redundant_terms(known: Mapping[str, float], force_input: bool) -> dict[str, 
                          f"the baseline identifies (not given), so its gain would be the "
                          f"prior conflict of {which}, reported as such; give {which} in the "
                          "sidecar to test a mass error")
+        elif t.kind == "ground" and force_input:
+            out[name] = (f"{name} is not a candidate: with a force input the base is fixed "
+                         "(or the recording was rewritten with its friction on the ground), "
+                         "so friction on the ground is the baseline's own")
     return out
 
 

@@ -287,16 +287,12 @@ def drifting_friction(lf: LatentForce, f: np.ndarray) -> Shape:
 
 
 def base_velocity(lf: LatentForce) -> np.ndarray:
-    """y' (m/s) from the base acceleration: its integral less its linear trend (the unknown
-    initial velocity, a bias of y''); zeros for a force input (the base is fixed). A
-    high-pass against further drift (0.05 Hz, zero phase) cost the frame's 1 Hz velocity
-    its shape at the record's ends (correlation 0.85 with y' from the displacement, 0.99996
-    without)."""
+    """y' (m/s) of the latent force's record (``model.simulate.base_velocity``, what a
+    ``ground`` term of the model sees); zeros for a force input (the base is fixed)."""
     if lf.input_kind != "base_acc":
         return np.zeros_like(lf.input)
-    dt = float(lf.time[1] - lf.time[0])
-    v = np.concatenate([[0.0], np.cumsum(0.5 * (lf.input[1:] + lf.input[:-1]) * dt)])
-    return signal.detrend(v)
+    from harvester.model.simulate import base_velocity as of_input
+    return of_input(lf.input, float(lf.time[1] - lf.time[0]))
 
 
 def friction_on_ground(lf: LatentForce, f: np.ndarray) -> Shape:

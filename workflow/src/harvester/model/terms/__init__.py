@@ -31,6 +31,11 @@ of eq. 1). Kinds of term and the signature of their force law:
               ``masses`` take the modal mass out of the rigid part's
 ``coupling``  a dead zone between the mass and the screw-side inertia (states d, d'):
               f_b = force(d, d', M, m, *params) transmitted between them
+``ground``    f = force(x', *params) on the mass, x' = z' + y' its own (absolute) velocity: a
+              contact fixed to the ground (Marino and Cicirello's frame), beside what acts
+              on the base; y' is the base acceleration's integral less its linear trend
+              (``harvester.model.simulate.base_velocity``), 0 with a force input (the base
+              is the ground there)
 ``stick``     dry friction that holds, on the screw-side velocity w: while sliding,
               f = sgn(w) force(|w|, *params) (the magnitude at speed |w| >= 0); stuck
               (w = 0 exactly) while the force it must supply stays within the holding level
@@ -64,7 +69,7 @@ V_BOUND = 1.0
 Z_PER_V = 1.0 / (2.0 * np.pi * 0.5)
 Z_BOUND = Z_PER_V * V_BOUND
 
-KINDS = ("screw", "mass", "inertia", "mode", "coupling", "stick")
+KINDS = ("screw", "mass", "inertia", "mode", "coupling", "stick", "ground")
 
 #: The device quantities a sidecar may state that a term may imply (``Term.device``).
 DEVICE_QUANTITIES = ("M", "m", "k")
@@ -242,10 +247,10 @@ STICKING_FRICTION: tuple[str, ...] = ("sticking_friction",)
 
 def is_friction(t: Term) -> bool:
     """Whether a term is a friction law: a sliding law (``SLIDING_FRICTION``, Dahl's
-    pre-sliding ``hysteresis`` among them; ``STICKING_FRICTION``) or a refinement of one
-    (Stribeck, asymmetry)."""
+    pre-sliding ``hysteresis`` among them; ``STICKING_FRICTION``), a refinement of one
+    (Stribeck, asymmetry) or a contact on the ground (``ground``)."""
     sliding = SLIDING_FRICTION + STICKING_FRICTION
-    return t.name in sliding or bool(set(t.refines) & set(sliding))
+    return t.kind == "ground" or t.name in sliding or bool(set(t.refines) & set(sliding))
 
 
 def check_term(t: Term) -> None:
@@ -270,8 +275,8 @@ def check_term(t: Term) -> None:
         problems.append("a stick term, and only one, gives static (its holding level)")
     if t.transition is not None and t.kind != "stick":
         problems.append("transition is for a stick term")
-    if t.kind == "stick" and t.n_states:
-        problems.append("a stick term has no states of its own")
+    if t.kind in ("stick", "ground") and t.n_states:
+        problems.append(f"a {t.kind} term has no states of its own")
     if t.kind in ("inertia", "mode") and not callable(t.masses):
         problems.append(f"an {t.kind} term needs masses")
     if t.device is not None and not callable(t.device):
