@@ -530,7 +530,8 @@ def test_a_failed_fit_is_sampled_only_where_a_trusted_importance_estimate_leaves
     assert "single effects' scores" in skip_reason(stop, [], cs, 3, single_scores=True)
     # nor once another candidate is accepted
     from types import SimpleNamespace
-    mode = SimpleNamespace(effect="unmodelled_mode", accepted=True, contradicted=[], unresolved={})
+    mode = SimpleNamespace(effect="unmodelled_mode", accepted=True, contradicted=[], unresolved={},
+                           unshown=False)
 
     def estimate():
         raise AssertionError("estimated after another candidate was accepted")
