@@ -26,7 +26,9 @@ from harvester.model.terms import V_EPS, Motion, Parameter, Probe, RateBound, Te
 
 
 def force(x_dot, F_ground):
-    """f = F_ground tanh(x' / V_EPS) (N), x' the mass's absolute velocity (m/s)."""
+    """f = F_ground tanh(x' / V_EPS) (N), x' the mass's absolute velocity (m/s). Coulomb's
+    law, written here rather than imported: a kernel's cache key hashes its terms' own files
+    (``codegen._dependencies``), so a law imported from another file could go stale."""
     return F_ground * fm.tanh(x_dot / V_EPS)
 
 
