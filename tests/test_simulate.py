@@ -408,3 +408,29 @@ def test_friction_on_the_ground_follows_a_reference_solution():
                    ydd, dt)
     x_dot = sim.rel_vel[0] + A * w * np.cos(w * t)
     assert np.max(np.abs(f[0] - F * np.tanh(x_dot / 1e-3))) < 0.1 * F
+
+
+def test_numba_label_counter_stays_short_over_kernels(tmp_path):
+    """Numba's block-label counter doubles with each nested inline (a kernel adds 6-11
+    digits): after some tens of kernels in one process LLVM refuses the labels ("name is too
+    long"; the literature grid's runner at its 21st record). ``codegen.bound_labels`` puts it
+    back before each kernel compiles: over three kernels compiled in a fresh process with a
+    cold kernel cache it stays under 21 digits (30 without it)."""
+    import os
+    import subprocess
+    import sys
+    code = (
+        "import numpy as np\n"
+        "from numba.core import ir_utils\n"
+        "from harvester.model.simulate import simulate\n"
+        "from harvester.model.structures import structure\n"
+        "for name in ('tanh', 'tanh+coulomb_friction', 'tanh+hysteresis'):\n"
+        "    s = structure(name)\n"
+        "    p = np.full((1, len(s.layout.parameter_names)), 0.5)\n"
+        "    simulate(s.layout, p, np.sin(np.arange(64) / 5.0), 1 / 64.0)\n"
+        "print(len(str(ir_utils._the_max_label._value)))\n")
+    env = {**os.environ, "HARVESTER_CACHE": str(tmp_path)}
+    run = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                         text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert int(run.stdout.split()[-1]) <= 20

@@ -362,6 +362,30 @@ def source(terms: tuple[str, ...], driver: str) -> str:
           [f"{jit}, nogil=True)", _integrate_source(objs, driver)])])
 
 
+# --------------------------------------------------------------------------- the compiler
+
+#: Where Numba's block-label counter is put back before a kernel compiles (``bound_labels``).
+LABEL_START = 1 << 20
+
+
+def bound_labels() -> None:
+    """Put Numba's block-label counter back to LABEL_START before a kernel compiles.
+
+    Numba numbers the blocks it inlines from one counter per process
+    (``numba.core.ir_utils._the_max_label``), offsetting a callee's blocks by it; a callee
+    that itself inlined (``rhs`` holding the terms' laws, inlined four times a step) brings
+    labels of the counter's size, so the counter doubles at each such inline and a kernel
+    adds 6-11 digits to it. After some tens of kernels in one process LLVM refuses the
+    labels ("name is too long": the literature grid's runner failed at its 21st record,
+    compiling from a cold cache). Within one function's compile the labels only need to
+    exceed its own, which Numba ensures (``max(next(), max(blocks))``); between kernels the
+    counter may start again. Put back so, it stays at 13-17 digits over seven kernels, with
+    the same numbers out."""
+    from numba.core import ir_utils
+    counter = ir_utils._the_max_label
+    counter._value = min(counter._value, LABEL_START)
+
+
 # --------------------------------------------------------------------------- the cache
 
 

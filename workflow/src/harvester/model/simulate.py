@@ -143,6 +143,7 @@ def _in_threads(block, blocks: Blocks, dt: float, head: tuple, tail: tuple) -> N
     if head[0] not in _warm:
         # the first call of a kernel runs one block alone: it compiles what the others need
         # (Numba's dispatchers are not safe to compile from two threads at once: seen to crash)
+        codegen.bound_labels()
         block(*head, *jobs[-1], *tail)
         jobs = jobs[:-1]
         _warm.add(head[0])
