@@ -104,10 +104,9 @@ def turning_point(w0, w1, dx, h):
             + dx * s * s * (3.0 - 2.0 * s))
 
 
-def has_ground(terms) -> bool:
+def has_ground(terms: tuple[Term, ...]) -> bool:
     """Whether a structure holds a term on the mass's absolute velocity (``ground``)."""
-    return any(term(t).kind == "ground" if isinstance(t, str) else t.kind == "ground"
-               for t in terms)
+    return any(t.kind == "ground" for t in terms)
 
 
 def _names(terms: tuple[Term, ...]) -> tuple[list[str], list[str]]:
