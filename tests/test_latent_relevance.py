@@ -188,3 +188,43 @@ def test_a_term_named_beside_another_is_sized_by_its_own_force():
     off = size("c", 0.01)
     off.floor = RelevanceFloor(enabled=False)
     assert negligible_beside([size("a", 22.6), off]) == []
+
+
+def test_names_that_are_all_negligible_leave_missing():
+    """The literature generator's spring dead zone (base_disp -> rel_disp): a mass error and a
+    cubic spring accepted, together 0.20 % of the drive, "detectable but negligible", were
+    listed as missing physics under a verdict that rests on a mismatch shown but not
+    explained. Every name negligible: none is the mismatch's, so they leave ``missing`` for
+    ``negligible``, and the headline says so; one relevant name keeps its place."""
+    from types import SimpleNamespace
+
+    from harvester.diagnosis.name.verdict import Conclusion, FitJudgement, judge
+    from harvester.diagnosis.prepare.settings import DiagnosisSettings
+    from harvester.diagnosis.size.relevance import EffectSize, OwnForce, RelevanceFloor
+
+    def size(term, own_rms, drive=0.9):
+        own = OwnForce((own_rms,) * 3, (0.0,) * 3, (own_rms,) * 3, False)
+        floor = RelevanceFloor()
+        share = own_rms / drive
+        return EffectSize(term, own_rms, share, 0.3, None, None, share < floor.force_share,
+                          floor, own=own, drive_rms_N=drive)
+
+    def judged(sizes):
+        desc = SimpleNamespace(sentence="a hysteresis loop in (z, f)", readable=True,
+                               determined=[], best=SimpleNamespace(name="loop", share=0.14))
+        missing = SimpleNamespace(sizes=sizes, description=desc, fitted_shape=None,
+                                  shape_speaks=False, together=None, residual_line=None,
+                                  latent=SimpleNamespace(noise_sd=1.0, baseline_noise_sd=2.0))
+        missing.sentence = lambda: desc.sentence
+        found = Conclusion("missing_physics", [s.term for s in sizes], [], False, [], None,
+                           True)
+        fit = FitJudgement(0.99, 0.0035, "holdout", 0.97, None, None)
+        detection = SimpleNamespace(p_value=1e-7, significant=True, conflict=False)
+        return judge(found, detection, fit, "tanh", DiagnosisSettings(), missing)
+
+    both = judged([size("inertia_error", 0.0012), size("cubic_stiffness", 0.0006)])
+    assert both.missing == [] and both.negligible == ["inertia_error", "cubic_stiffness"]
+    assert "detectable but negligible: inertia_error" in both.headline
+    assert "missing: " not in both.headline
+    one = judged([size("cubic_stiffness", 0.2)])
+    assert one.missing == ["cubic_stiffness"] and one.negligible == []

@@ -111,7 +111,7 @@ def test_a_candidate_whose_device_contradicts_the_sidecar_is_not_accepted() -> N
     other = CandidateResult("cubic_stiffness", None, 48.0, 0.1, 6.0, True)
     mark_ties([wild, other], cs)
     assert other.named and wild.indistinguishable_from == []
-    screened = SimpleNamespace(failed=False, pulled={}, bound=47.0,
+    screened = SimpleNamespace(failed=False, pulled={}, bound=47.0, beyond_band={},
                                importance_ceiling=lambda sigmas: None)
     assert skip_reason(screened, [wild, other], cs, 2) is None  # the refused one not counted
     assert skip_reason(screened, [kept, other], cs, 2) is not None

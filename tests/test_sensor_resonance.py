@@ -171,6 +171,30 @@ def test_a_mode_above_the_likelihoods_band_is_not_named():
     assert "above the 81.9 Hz band the likelihood compares" in above.unresolved_sentence()
     inside = judge("unmodelled_mode", fit(60.0, 18.2), base, cs)
     assert inside.accepted and not inside.beyond_band
-    screened = SimpleNamespace(failed=False, pulled={}, bound=47.0,
+    screened = SimpleNamespace(failed=False, pulled={}, bound=47.0, beyond_band={},
                                importance_ceiling=lambda sigmas: None)
     assert skip_reason(screened, [above], cs, 1) is None  # not counted in the round's top
+
+
+def test_a_mode_whose_best_fit_lies_above_the_band_is_not_sampled():
+    """confirm.skip_reason: a screened mode whose MAP puts f_mode above the likelihood's band
+    would not be named, so its TMCMC is not spent (the Bouc-Wen records' 104-218 Hz); the same
+    fit with f_mode inside the band is sampled."""
+    from types import SimpleNamespace
+
+    from harvester.diagnosis.name.confirm import ConfirmSettings, skip_reason
+    from harvester.diagnosis.name.screen import Screened
+    names = ("k", "f_mode", "zeta_mode", "mass_mode", "drive_base", "sigma")
+
+    def screened(f_mode):
+        theta = np.array([1.0, f_mode, 0.02, 0.3, 0.0, 0.1])
+        return Screened("unmodelled_mode", names, theta, 0.0, 200.0, 230.0, False, 0, 0.0,
+                        problem=SimpleNamespace(band_hz=81.92))
+
+    cs = ConfirmSettings()
+    above = screened(103.9)
+    assert above.beyond_band == {"f_mode": (103.9, 81.92)}
+    assert "f_mode at 103.9 Hz, above the 81.9 Hz band" in skip_reason(above, [], cs, 3)
+    assert above.to_dict()["map_beyond_band_hz"]["f_mode"]["map"] == 103.9
+    inside = screened(41.8)
+    assert not inside.beyond_band and skip_reason(inside, [], cs, 3) is None

@@ -89,6 +89,8 @@ class Diagnosis:
     fit_judgement: FitJudgement | None = None
     missing_force: MissingForce | None = None
     withheld: list[str] = field(default_factory=list)
+    #: accepted effects whose own force is negligible, not in ``missing`` (``Conclusion``)
+    negligible: list[str] = field(default_factory=list)
     budget: dict = field(default_factory=dict)  # ``name.budget.budget_dict``
 
     @property
@@ -271,7 +273,7 @@ def _diagnosis(a: Analysis, start: BaselineStart, rounds: list[Round],
         window_s=(float(t[a.lead]), float(t[a.hold - 1])),
         fit_window_s=(float(t[a.lead]), float(t[a.fit_stop - 1])), settings=settings,
         priors=start.priors, seconds=seconds, time=t, notes=notes, headline=found.headline,
-        fit_judgement=found.fit, withheld=found.withheld)
+        fit_judgement=found.fit, withheld=found.withheld, negligible=found.negligible)
 
 
 def write(diag: Diagnosis, out_dir: str | Path, title: str | None = None) -> Path:

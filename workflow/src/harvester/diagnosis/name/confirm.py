@@ -660,8 +660,12 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     even estimated. A candidate whose best fit lies on a bound its posterior must pile
     against (``Screened.pulled``) would not be trusted (:func:`judge`), so it cannot be
     named; it is sampled only where a candidate accepted before it leaves it a tie to make.
-    None: sample it (always where it was not screened). ``estimate`` False: the reasons that
-    need no importance-sampling estimate only (the time budget is spent)."""
+    One whose best fit puts a resonance above the likelihood's band
+    (``Screened.beyond_band``) would not be named either (:func:`beyond_band`): on the
+    literature generator's Bouc-Wen records a mode's TMCMC at 104-218 Hz above the 81.9 Hz
+    band spent the time budget before the other candidates were sampled. None: sample it
+    (always where it was not screened). ``estimate`` False: the reasons that need no
+    importance-sampling estimate only (the time budget is spent)."""
     if screened is None:
         return None
     if top is not None and len([r for r in results
@@ -670,6 +674,11 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     if screened.pulled and not screened.failed and not any(r.accepted for r in results):
         return (f"its best fit has {screened.pull_phrase()}: its posterior would pile there "
                 "and not be trusted, and no candidate was accepted for it to tie with")
+    if screened.beyond_band and not screened.failed:
+        return ("its best fit puts " + ", ".join(
+            f"{n} at {x:.1f} Hz" for n, (x, _) in screened.beyond_band.items())
+            + f", above the {next(iter(screened.beyond_band.values()))[1]:.1f} Hz band the "
+            "likelihood compares: a resonance the record does not show, which is not named")
     least = settings.acceptance_base + settings.mc_sigmas * float(np.hypot(nested_se,
                                                                            BRIDGE_MIN_SE))
     if screened.failed:  # its bound means nothing; a trusted estimate still does

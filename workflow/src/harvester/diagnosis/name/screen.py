@@ -145,6 +145,19 @@ class Screened:
         sigma = np.sqrt(np.where(ok, sse, np.nan) / self.problem.n_data)
         return np.column_stack([theta, sigma[np.ravel(inverse)]])
 
+    @property
+    def beyond_band(self) -> dict[str, tuple[float, float]]:
+        """The term's resonance frequencies (``Term.in_band``) whose best fit lies above the
+        band the likelihood compares: name -> (MAP, band top), Hz. The confirmation would not
+        name the term with its posterior there (``confirm.beyond_band``), so its sampling
+        would buy no name."""
+        names = [n for n in term(self.effect).in_band if n in self.names]
+        if not names or self.problem is None:
+            return {}
+        band = float(self.problem.band_hz)
+        at = {n: float(self.theta[self.names.index(n)]) for n in names}
+        return {n: (x, band) for n, x in at.items() if x > band}
+
     def pull_phrase(self, bounds: dict[str, tuple[str, float]] | None = None) -> str:
         """``bounds`` (default ``pulled``) in words, for logs and the reasons a candidate
         was not sampled."""
@@ -190,6 +203,8 @@ class Screened:
                                      "posterior_must_pile": drop > PILE_NATS}
                                  for n, (side, drop) in self.on_bound.items()},
                 "smoothness": None if self.smooth is None else self.smooth.to_dict(),
+                "map_beyond_band_hz": {n: {"map": x, "band_top": b}
+                                       for n, (x, b) in self.beyond_band.items()},
                 "sampled": self.sampled, "skipped": self.skipped}
 
 

@@ -164,7 +164,7 @@ def _finite(obj):
 #: The version of diagnosis.json's contract (``diagnosis.schema.json`` beside this module,
 #: docs/diagnosis-json.md): the major number changes when a key is removed or changes its
 #: meaning, the minor one when a key is added.
-SCHEMA_VERSION = "1.2"
+SCHEMA_VERSION = "1.3"
 #: The JSON Schema diagnosis.json validates against, shipped with the package.
 SCHEMA_PATH = Path(__file__).with_name("diagnosis.schema.json")
 
@@ -213,6 +213,7 @@ def _device_plausibility(d) -> dict:
     for i, rnd in enumerate(d.rounds):
         for r in rnd.confirmed:
             role = ("named" if r.effect in d.missing and r.accepted else
+                    "negligible" if r.effect in d.negligible and r.accepted else
                     "tied" if r.effect in tied and (r.accepted or r.indistinguishable_from)
                     else "withheld" if r.effect in d.withheld and r.accepted else
                     "refused" if r.refused_for_device else None)
@@ -293,6 +294,7 @@ def _diagnosis_dict(d) -> dict:
         "missing_force": None if d.missing_force is None else d.missing_force.to_dict(),
         "missing": d.missing,
         "withheld": d.withheld,
+        "negligible": d.negligible,
         "indistinguishable": d.indistinguishable,
         "ties": [tie.to_dict() for tie in d.ties],
         "device_plausibility": _device_plausibility(d),

@@ -75,6 +75,9 @@ def _missing_lines(doc: Mapping[str, Any]) -> list[str]:
              for e in doc.get("missing") or []]
     if mf.get("together"):
         lines.append(_together_line(mf["together"], sizes))
+    if doc.get("negligible"):
+        lines.append("detectable but negligible, not the mismatch's: "
+                     + ", ".join(_esc(e) for e in doc["negligible"]))
     if doc.get("withheld"):
         lines.append("not named, their force lacks the missing force's shape: "
                      + ", ".join(_esc(e) for e in doc["withheld"]))
