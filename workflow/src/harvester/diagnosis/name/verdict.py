@@ -212,8 +212,8 @@ class Conclusion:
     refused: list[str] = field(default_factory=list)
     #: steps of the search the time budget cut (``budget``): neither named nor rejected
     unfinished: list[Unfinished] = field(default_factory=list)
-    #: effects accepted by evidence whose own force is negligible (``relevance``): beside a
-    #: relevant name, or every name of the conclusion; not in ``missing``
+    #: effects accepted by evidence whose own force is negligible beside a relevant name
+    #: (``relevance.negligible_beside``); not in ``missing``
     negligible: list[str] = field(default_factory=list)
 
 
@@ -357,8 +357,6 @@ def judge(found: Conclusion, first: Detection, fit: FitJudgement, baseline: str,
     beside = negligible_beside(sizes)
     found = replace(found, missing=[e for e in found.missing if e not in beside],
                     negligible=[e for e in found.missing if e in beside])
-    if sizes and all(s.negligible for s in sizes):  # no name explains the mismatch
-        found = replace(found, missing=[], negligible=found.negligible + found.missing)
     little = explains_little(sizes, fit.library_share())
     relevant = not sizes or any(not s.negligible and not s.little for s in sizes)
     shown = mismatch_shown(fit, missing)
@@ -512,9 +510,6 @@ def headline(verdict: str, found: Conclusion, fit: FitJudgement, baseline: str,
         # accepted effects below the relevance floor leave the verdict adequate
         label = "missing" if verdict != "adequate" else "detectable but negligible"
         parts.append(f"{label}: " + _named(found, missing, units))
-    elif found.negligible:  # every name negligible: none is the mismatch's
-        parts.append("detectable but negligible: "
-                     + _named(replace(found, missing=found.negligible), missing, units))
     if found.withheld:
         parts.append(f"no library name: {', '.join(found.withheld)} lack the missing force's "
                      "shape")
