@@ -189,7 +189,11 @@ def confusion(records) -> tuple[pd.DataFrame, pd.DataFrame]:
                      "correct": " ".join(sorted(rec.correct)) or "-",
                      "names": " ".join(missing) or "-", "friction_form": form or "-",
                      "budget_cut": bool((d.get("budget") or {}).get("cut")),
-                     "mass_error_not_put_in": "inertia_error" in missing
+                     # named as missing physics (a flagging verdict), or only listed under
+                     # an adequate one as detectable but negligible
+                     "mass_error_not_put_in": "inertia_error" in missing and row["flagged"]
+                     and "inertia_error" not in rec.correct,
+                     "mass_error_listed": "inertia_error" in missing
                      and "inertia_error" not in rec.correct})
     table = pd.DataFrame(rows)
     return table, confusion_matrix(table) if rows else pd.DataFrame()
@@ -212,7 +216,9 @@ def print_confusion(records) -> None:
     print(f"\nlibrary effects: {len(lib)} records, {counts}; outside the library: "
           f"{int((~table['effect_free'] & (table['correct'] == '-')).sum())}; effect-free: "
           f"{len(free)}, false alarms {int(free['flagged'].sum())}; mass error named where "
-          f"none was put in: {int(table['mass_error_not_put_in'].sum())}; the time budget "
+          f"none was put in: {int(table['mass_error_not_put_in'].sum())} (listed under an "
+          f"adequate verdict: {int((table['mass_error_listed'] & ~table['flagged']).sum())})"
+          f"; the time budget "
           f"cut the search on {int(table['budget_cut'].sum())} of {len(table)}")
 
 

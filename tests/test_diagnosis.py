@@ -292,6 +292,38 @@ def _result(effect, delta, se=0.3, accepted=True):
     return CandidateResult(effect, None, delta, se, 3.0 + 2 * se, accepted)
 
 
+def test_a_rival_the_budget_left_unsampled_that_could_reach_the_name_makes_a_tie():
+    """confirm.budget_rivals: the literature generator's LuGre record as force -> rel_disp
+    named a mode (+97.8 nats) while hysteresis, its best fit's bound +104.7, was left
+    unsampled by the budget: the mode is not named alone. A rival whose bound cannot reach
+    the name less the margin, one of the same physics, or one skipped for another reason
+    leaves the name standing."""
+    from harvester.diagnosis.name.confirm import (BUDGET_REASON, STOPPED_REASON,
+                                                   ConfirmSettings, budget_rivals)
+    cs = ConfirmSettings()
+
+    def screened(effect, bound, skipped):
+        s = _screened(effect, bound)
+        s.skipped = skipped
+        return s
+
+    mode = [_result("unmodelled_mode", 97.8, se=0.05)]
+    fitted = {"hysteresis": screened("hysteresis", 104.7, BUDGET_REASON)}
+    assert budget_rivals(mode, fitted, cs) == ["hysteresis"] and not mode[0].named
+    stopped = [_result("unmodelled_mode", 97.8, se=0.05)]
+    fitted = {"hysteresis": screened("hysteresis", 95.0, f"{STOPPED_REASON} (chain 0)")}
+    assert budget_rivals(stopped, fitted, cs) == ["hysteresis"]
+    kept = [_result("unmodelled_mode", 97.8, se=0.05)]
+    fitted = {"inertia_error": screened("inertia_error", 87.3, BUDGET_REASON),
+              "hysteresis": screened("hysteresis", 104.7, "its best fit has F_hyst on its "
+                                     "lower bound"),
+              "coulomb_friction": screened("coulomb_friction", 1.4, BUDGET_REASON)}
+    assert budget_rivals(kept, fitted, cs) == [] and kept[0].named
+    same = [_result("coulomb_friction", 50.0, se=0.05)]
+    fitted = {"sticking_friction": screened("sticking_friction", 60.0, BUDGET_REASON)}
+    assert budget_rivals(same, fitted, cs) == [] and same[0].named
+
+
 def test_an_effect_is_named_alone_only_beyond_the_threshold_of_every_different_rival():
     from harvester.diagnosis.name.confirm import ConfirmSettings, mark_ties
     cs = ConfirmSettings()

@@ -484,7 +484,7 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
         except OutOfTime as stop:
             name = baseline.structure.with_term(effect).name
             cut.append(Unfinished.stopped(where, name, stop))
-            _skipped(screened, effect, f"not finished within the time budget ({stop})")
+            _skipped(screened, effect, f"{STOPPED_REASON} ({stop})")
             continue
         if result is None:
             _skipped(screened, effect, rough_reason(screened))
@@ -497,11 +497,14 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
                                               baseline.structure, order, settings.candidates)
     results.sort(key=lambda r: -r.delta_log_evidence)
     mark_ties(results, settings)
+    if cut:
+        budget_rivals(results, fitted, settings)
     return results
 
 
-#: Why a candidate the time budget left was not sampled.
+#: Why a candidate the time budget left was not sampled, or why its sampling stopped.
 BUDGET_REASON = "the time budget ran out before it"
+STOPPED_REASON = "not finished within the time budget"
 
 
 def _skip(screened, effect: str, reason: str, pulled: bool, structure: ModelStructure,
@@ -735,6 +738,37 @@ def _fitted_reason(screened, results: list[CandidateResult], settings: ConfirmSe
                 + (f"the acceptance threshold {least:.1f}" if floor <= least else
                    f"{best.effect}'s {best.delta_log_evidence:.1f} less the naming margin"))
     return None
+
+
+def budget_rivals(results: list[CandidateResult], fitted: Mapping, settings: ConfirmSettings
+                  ) -> list[str]:
+    """The best accepted candidate is not named alone where the time budget left a screened
+    rival of other physics unsampled (or stopped its TMCMC) whose best fit could reach it: its
+    evidence bound at least the best's gain less the naming margin, so that sampled it could
+    tie or lead (``skip_reason`` would have sampled it). Such rivals are recorded as
+    indistinguishable from it, the evidence on them not in; a candidate whose best fit failed
+    or puts a resonance above the band is not one. On the literature generator's LuGre record
+    as force -> rel_disp a mode was named (+97.8 nats) while hysteresis, its bound +104.7,
+    was left unsampled by the budget. Returns the rivals added. ``results`` best first."""
+    accepted = [r for r in results if r.accepted]
+    if not accepted:
+        return []
+    best = accepted[0]
+    least = best.delta_log_evidence - settings.base_threshold \
+        - settings.mc_sigmas * best.delta_se
+    added = []
+    for s in fitted.values():
+        cut = s.skipped is not None and (s.skipped == BUDGET_REASON
+                                         or s.skipped.startswith(STOPPED_REASON))
+        if cut and not s.failed and not s.beyond_band and s.bound >= least \
+                and not same_physics(s.effect, best.effect) \
+                and s.effect not in best.indistinguishable_from:
+            best.indistinguishable_from.append(s.effect)
+            added.append(s.effect)
+    if added:
+        log.info("%s not named alone: the time budget left %s unsampled, whose best fits "
+                 "could reach its evidence", best.effect, ", ".join(added))
+    return added
 
 
 def decisions(baseline: ModelFit, results: list[CandidateResult], settings: ConfirmSettings
