@@ -61,7 +61,7 @@ from harvester.diagnosis.detect.scores import Detection, at_prior_edge
 from harvester.diagnosis.name.fits import (BRIDGE_MIN_SE, MISSED_MODE_NATS, ModelFit, candidate_priors,
                                       prior_dict, scan_factor)
 from harvester.diagnosis.name.budget import OutOfTime, Unfinished, spent
-from harvester.diagnosis.name.screen import Screen
+from harvester.diagnosis.name.screen import Screen, above_band
 from harvester.data.sidecar import DEFAULT_RELATIVE_SD
 from harvester.diagnosis.prepare.redundant import used_quantities
 from harvester.diagnosis.name.plausibility import (Implied, contradictions, implied_device,
@@ -477,22 +477,11 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
             continue
         log.info("confirming %s (%d of %d)", baseline.structure.with_term(effect).name, i + 1,
                  len(order))
-        begun = time.perf_counter()
-        try:
-            result = _confirm_one(baseline, effect, screened, priors, settings, scale,
-                                  detection, seed_offset + 101 * (i + 1), results)
-        except OutOfTime as stop:
-            name = baseline.structure.with_term(effect).name
-            cut.append(Unfinished.stopped(where, name, stop))
-            _skipped(screened, effect, f"{STOPPED_REASON} ({stop})")
-            continue
+        result = _sampled(baseline, effect, screened, priors, settings, scale, detection,
+                          seed_offset + 101 * (i + 1), results, cut, where)
         if result is None:
-            _skipped(screened, effect, rough_reason(screened))
             continue
-        result.seconds = time.perf_counter() - begun
         results.append(result)
-        if screened is not None:
-            screened.sampled = True
         order[i + 1:i + 1] = limit_candidates(effect, results[-1].at_limit,
                                               baseline.structure, order, settings.candidates)
     results.sort(key=lambda r: -r.delta_log_evidence)
@@ -500,6 +489,30 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
     if cut:
         budget_rivals(results, fitted, settings)
     return results
+
+
+def _sampled(baseline: ModelFit, effect: str, screened, priors: Mapping[str, PriorSpec],
+             settings: ConfirmSettings, scale: DeviceScale, detection: Detection | None,
+             seed: int, results: list[CandidateResult], cut: list[Unfinished],
+             where: str) -> CandidateResult | None:
+    """One candidate's result (:func:`_confirm_one`) with its wall time, marked sampled on
+    its screen; None where the deadline stopped it (appended to ``cut``) or its likelihood
+    jumps and no estimate is trusted, each said on ``screened``."""
+    begun = time.perf_counter()
+    try:
+        result = _confirm_one(baseline, effect, screened, priors, settings, scale, detection,
+                              seed, results)
+    except OutOfTime as stop:
+        cut.append(Unfinished.stopped(where, baseline.structure.with_term(effect).name, stop))
+        _skipped(screened, effect, f"{STOPPED_REASON} ({stop})")
+        return None
+    if result is None:
+        _skipped(screened, effect, rough_reason(screened))
+        return None
+    result.seconds = time.perf_counter() - begun
+    if screened is not None:
+        screened.sampled = True
+    return result
 
 
 #: Why a candidate the time budget left was not sampled, or why its sampling stopped.
@@ -677,11 +690,12 @@ def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSetti
     if screened.pulled and not screened.failed and not any(r.accepted for r in results):
         return (f"its best fit has {screened.pull_phrase()}: its posterior would pile there "
                 "and not be trusted, and no candidate was accepted for it to tie with")
-    if screened.beyond_band and not screened.failed:
-        return ("its best fit puts " + ", ".join(
-            f"{n} at {x:.1f} Hz" for n, (x, _) in screened.beyond_band.items())
-            + f", above the {next(iter(screened.beyond_band.values()))[1]:.1f} Hz band the "
-            "likelihood compares: a resonance the record does not show, which is not named")
+    above = screened.beyond_band
+    if above and not screened.failed:
+        at = ", ".join(f"{n} at {x:.1f} Hz" for n, (x, _) in above.items())
+        band = max(b for _, b in above.values())
+        return (f"its best fit puts {at}, above the {band:.1f} Hz band the likelihood "
+                "compares: a resonance the record does not show, which is not named")
     least = settings.acceptance_base + settings.mc_sigmas * float(np.hypot(nested_se,
                                                                            BRIDGE_MIN_SE))
     if screened.failed:  # its bound means nothing; a trusted estimate still does
@@ -852,12 +866,9 @@ def beyond_band(effect: str, fit: ModelFit) -> dict[str, tuple[float, float]]:
     the 81.9 Hz band on four of the eight effects (dead zone, ground friction, Dahl,
     backlash), and named on two (December 2026, 3289362): the filter's edge, not a part of the
     device."""
-    names = [n for n in term(effect).in_band if n in fit.names]
-    if not names:
-        return {}
-    band = float(fit.problem.band_hz)
-    medians = {n: float(np.median(fit.samples[:, fit.names.index(n)])) for n in names}
-    return {n: (x, band) for n, x in medians.items() if x > band}
+    return above_band(effect, fit.names,
+                      lambda n: np.median(fit.samples[:, fit.names.index(n)]),
+                      lambda: fit.problem.band_hz)
 
 
 def candidate_device(effect: str, fit: ModelFit, settings: ConfirmSettings) -> list[Implied]:

@@ -95,6 +95,19 @@ IMPORTANCE_ADAPT = 2
 IMPORTANCE_SLACK = 1.0
 
 
+def above_band(effect: str, names, value: Callable[[str], float],
+               band_top: Callable[[], float]) -> dict[str, tuple[float, float]]:
+    """The term's resonance frequencies (``Term.in_band``) among ``names`` whose ``value``
+    (a best fit's, a posterior's median) lies above the top of the band the likelihood
+    compares (``band_top``, asked only for a term that has such frequencies):
+    name -> (value, band top), Hz."""
+    at = {n: float(value(n)) for n in term(effect).in_band if n in names}
+    if not at:
+        return {}
+    band = float(band_top())
+    return {n: (x, band) for n, x in at.items() if x > band}
+
+
 @dataclass
 class Screened:
     """One candidate's best fit and the most evidence it can gain over the nested model."""
@@ -151,12 +164,11 @@ class Screened:
         band the likelihood compares: name -> (MAP, band top), Hz. The confirmation would not
         name the term with its posterior there (``confirm.beyond_band``), so its sampling
         would buy no name."""
-        names = [n for n in term(self.effect).in_band if n in self.names]
-        if not names or self.problem is None:
+        if self.problem is None:
             return {}
-        band = float(self.problem.band_hz)
-        at = {n: float(self.theta[self.names.index(n)]) for n in names}
-        return {n: (x, band) for n, x in at.items() if x > band}
+        return above_band(self.effect, self.names,
+                          lambda n: self.theta[self.names.index(n)],
+                          lambda: self.problem.band_hz)
 
     def pull_phrase(self, bounds: dict[str, tuple[str, float]] | None = None) -> str:
         """``bounds`` (default ``pulled``) in words, for logs and the reasons a candidate
