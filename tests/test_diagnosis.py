@@ -17,6 +17,7 @@ from harvester.diagnosis.name.verdict import decide_verdict
 from harvester.inference.map_fit import ChainProblem, chain_problem
 from harvester.diagnosis.detect.scores import estimate_temper
 from harvester.diagnosis.name.rank import rank
+from harvester.diagnosis.detect.signatures import candidate_terms
 from harvester.diagnosis.detect.spectral import filter_cutoff
 from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
 from harvester.inference.problems import make_problem
@@ -324,6 +325,53 @@ def test_a_rival_the_budget_left_unsampled_that_could_reach_the_name_makes_a_tie
     assert budget_rivals(same, fitted, cs) == [] and same[0].named
 
 
+def test_a_term_whose_limits_fit_far_worse_is_told_from_them():
+    """confirm.apart_from_limits: hysteresis unresolved (1.08 um below the 8.3 um the record
+    resolves) and piled on its lower bound is accepted where its limits, both screened, fall
+    short of it by more than the naming margin (the Bouc-Wen friction as base_disp ->
+    rel_disp: +212.3 against +15.1 and +1.7); not where one comes within the margin (the
+    frame's stand-in bristle), was not screened, or failed; an edge of another parameter
+    still leaves it untrusted."""
+    from harvester.diagnosis.name.confirm import ConfirmSettings, apart_from_limits
+    cs = ConfirmSettings()
+
+    def hysteresis(delta=212.3, edges=None):
+        r = _result("hysteresis", delta, se=0.2, accepted=False)
+        r.unresolved = {"delta_hyst": (1.08e-6, 8.28e-6)}
+        r.at_prior_edge = dict(edges or {"delta_hyst": "lower"})
+        return r
+
+    limits = {"sticking_friction": _screened("sticking_friction", 15.1),
+              "coulomb_friction": _screened("coulomb_friction", 1.7)}
+    told = hysteresis()
+    assert apart_from_limits(told, limits, cs) == {"sticking_friction": 15.1,
+                                                  "coulomb_friction": 1.7}
+    assert told.accepted and not told.unshown and not told.untrusted_edges
+    assert told.at_limit == {}  # its limits are not sampled in its place
+    close = hysteresis()
+    near = {**limits, "sticking_friction": _screened("sticking_friction", 209.0)}
+    assert apart_from_limits(close, near, cs) == {} and not close.accepted and close.unshown
+    alone = hysteresis()
+    assert apart_from_limits(alone, {"coulomb_friction": limits["coulomb_friction"]}, cs) == {}
+    failed = {**limits, "coulomb_friction": _screened("coulomb_friction", 1.7, failed=True)}
+    assert apart_from_limits(hysteresis(), failed, cs) == {}
+    other = hysteresis(edges={"delta_hyst": "lower", "F_hyst": "lower"})
+    assert apart_from_limits(other, limits, cs) and not other.accepted
+    assert other.untrusted_edges == {"F_hyst": "lower"}
+    assert apart_from_limits(_result("cubic_stiffness", 50.0), limits, cs) == {}
+
+
+def test_laws_with_memory_are_screened_whatever_their_score():
+    """rank.unprobed_rivals: hysteresis and the hysteretic spring, whose probes can miss a
+    loop the record holds, are screened beside the ranked candidates where the structure can
+    take them and they are not listed already."""
+    from harvester.diagnosis.name.rank import unprobed_rivals
+    allowed = set(candidate_terms(()))
+    assert unprobed_rivals(["inertia_error"], allowed) == ["hysteresis", "hysteretic_spring"]
+    assert unprobed_rivals(["hysteresis"], allowed) == ["hysteretic_spring"]
+    assert unprobed_rivals([], allowed - {"hysteresis", "hysteretic_spring"}) == []
+
+
 def test_an_effect_is_named_alone_only_beyond_the_threshold_of_every_different_rival():
     from harvester.diagnosis.name.confirm import ConfirmSettings, mark_ties
     cs = ConfirmSettings()
@@ -481,6 +529,7 @@ def test_acceptance_shares_alpha_among_the_candidates_the_round_could_name():
     # effect-free record s7 of the literature grid: an offset force gained +3.41 nats, over
     # the per-candidate threshold 3.3, in a round that could have named any of 11 effects
     from types import SimpleNamespace
+
 
     from harvester.diagnosis.name.confirm import ConfirmSettings, judge, skip_reason
     from harvester.inference.priors import PriorSpec

@@ -237,9 +237,11 @@ def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings
             cut = r.fit.cut_sentence() if r.fit is not None else None
             if cut:
                 notes.append(cut)
-            if r.at_prior_edge:
-                notes.append(f"{r.effect}: the posterior of {', '.join(r.at_prior_edge)} piles "
-                             "against its prior's bound; the candidate is not trusted")
+            if r.untrusted_edges:
+                notes.append(f"{r.effect}: the posterior of {', '.join(r.untrusted_edges)} "
+                             "piles against its prior's bound; the candidate is not trusted")
+            if r.limits_short:
+                notes.append(limits_short_sentence(r))
             if r.unshown:
                 notes.append(f"{r.unresolved_sentence()} ({r.effect} gained "
                              f"{r.delta_log_evidence:+.1f} nats)")
@@ -256,6 +258,20 @@ def conclude(rounds: list[Round], unexplained: bool, settings: DiagnosisSettings
                       unsampled=[c.effect for rnd in rounds for c in rough_rivals(rnd)],
                       tried=tried_effects(rounds), refused=refused,
                       unfinished=[u for rnd in rounds for u in rnd.unfinished])
+
+
+def limits_short_sentence(r) -> str:
+    """Why a candidate whose displacement the record does not resolve, or whose posterior
+    piles where it becomes its limits, still stands (``CandidateResult.limits_short``)."""
+    where = [f"its {n} of {x * 1e6:.3g} um lies below the {res * 1e6:.3g} um the record "
+             "resolves" for n, (x, res) in r.unresolved.items()]
+    where += [f"the posterior of {n} piles against its prior's {side} bound"
+              for n, side in r.at_prior_edge.items() if n not in r.unresolved]
+    limits = ", ".join(f"{e} {b:+.1f}" for e, b in r.limits_short.items())
+    return (f"{r.effect}: {'; '.join(where)}, where the law becomes {' or '.join(r.limits_short)}"
+            f"; their best fits ({limits} nats at most) fall short of its "
+            f"{r.delta_log_evidence:+.1f} by more than the naming margin: the record tells the "
+            "law from them by its force, and that displacement is an upper bound, not a value")
 
 
 def tried_effects(rounds: list[Round]) -> set[str]:

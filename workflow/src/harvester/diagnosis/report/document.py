@@ -164,7 +164,7 @@ def _finite(obj):
 #: The version of diagnosis.json's contract (``diagnosis.schema.json`` beside this module,
 #: docs/diagnosis-json.md): the major number changes when a key is removed or changes its
 #: meaning, the minor one when a key is added.
-SCHEMA_VERSION = "1.3"
+SCHEMA_VERSION = "1.4"
 #: The JSON Schema diagnosis.json validates against, shipped with the package.
 SCHEMA_PATH = Path(__file__).with_name("diagnosis.schema.json")
 
