@@ -17,7 +17,10 @@ thresholds, SysIdentPy's polynomial NARX free run. pysindy and sysidentpy: ``pip
 
 ``--kept-only``: the diagnosis's rows only for records whose diagnosis is kept (none is run).
 ``--confusion``: the kept diagnoses only, per record (names, mass error named where none was
-put in, the friction's form taken) and their confusion matrix (``grid.scoring``).
+put in, the friction's form taken) and their confusion matrix (``grid.scoring``); the right
+names listed as detectable but negligible under an adequate verdict; and per term how often a
+flagging verdict names or ties it where it is not a right name (``grid.scoring.
+wrong_name_rates``, issue 63's 5 % bar).
 
 ``--make DIR``: writes literature-grid records into DIR as the grid makes them
 (config/config.yaml: 40 s at 256 Hz, ratio 0.5, the grid's seed offset): each of
@@ -165,7 +168,7 @@ def confusion(records) -> tuple[pd.DataFrame, pd.DataFrame]:
     put on the ground is named right by ``ground_friction``, or by a friction law with the
     form "ground". The matrix is
     ``grid.scoring.confusion_matrix`` of the rows (true scenario x first name)."""
-    from harvester.grid.scoring import confusion_matrix, score
+    from harvester.grid.scoring import accepted_names, confusion_matrix, score
     rows = []
     for rec in records:
         kept = rec.path.with_suffix(".diagnosis.json")
@@ -184,7 +187,15 @@ def confusion(records) -> tuple[pd.DataFrame, pd.DataFrame]:
         if ground and form != "ground" and "ground_friction" not in named \
                 and row["outcome"] in ("named", "tied"):
             row["outcome"] = "wrong"
-        rows.append({**row, "record": rec.path.stem,
+        said = missing + [e for t in d.get("ties") or [] for e in t.get("effects", [])]
+        right = accepted_names(truth["effect"], None, truth) if not row["effect_free"] \
+            else set()
+        rows.append({**row, "record": rec.path.stem, "right": right,
+                     # every name a flagging verdict gives (named or tied); the right name
+                     # listed under an adequate verdict as detectable but negligible
+                     "said": set(said) if row["flagged"] else set(),
+                     "right_but_negligible": not row["flagged"] and not row["effect_free"]
+                     and bool(set(missing + list(d.get("negligible") or [])) & right),
                      "kind": rec.truth.get("kind", "base_acc->rel_acc"),
                      "correct": " ".join(sorted(rec.correct)) or "-",
                      "names": " ".join(missing) or "-", "friction_form": form or "-",
@@ -201,6 +212,7 @@ def confusion(records) -> tuple[pd.DataFrame, pd.DataFrame]:
 
 def print_confusion(records) -> None:
     """The per-record table, the confusion matrix and the counts of :func:`confusion`."""
+    from harvester.grid.scoring import wrong_name_rates
     table, matrix = confusion(records)
     if table.empty:
         print("no kept diagnosis")
@@ -218,8 +230,14 @@ def print_confusion(records) -> None:
           f"{len(free)}, false alarms {int(free['flagged'].sum())}; mass error named where "
           f"none was put in: {int(table['mass_error_not_put_in'].sum())} (listed under an "
           f"adequate verdict: {int((table['mass_error_listed'] & ~table['flagged']).sum())})"
-          f"; the time budget "
+          f"; the right name listed as detectable but negligible under an adequate verdict: "
+          f"{int(table['right_but_negligible'].sum())}; the time budget "
           f"cut the search on {int(table['budget_cut'].sum())} of {len(table)}")
+    print("per term, in the names of a flagging verdict (named or tied) where it is not "
+          "a right name (issue 63's bar: 5 %):")
+    for name, (k, n) in wrong_name_rates(table).items():
+        print(f"  {name}: {k} of {n} ({100 * k / n:.1f} %){'  > 5 %' if k > 0.05 * n else ''}")
+
 
 
 def parser() -> argparse.ArgumentParser:

@@ -109,6 +109,20 @@ def test_confusion_matrix(results):
     assert per_ratio == len(results)
 
 
+def test_wrong_name_rates_count_each_term_where_it_is_not_right():
+    """Issue 63's catch-all count: a term named or tied under a flagging verdict where it is
+    not a right name, over the records where it is not; an adequate verdict says none."""
+    import pandas as pd
+    table = pd.DataFrame({
+        "said": [{"inertia_error"}, {"inertia_error", "unmodelled_mode"}, set(),
+                 {"inertia_error"}, {"hysteresis"}],
+        "right": [set(), {"hysteresis"}, set(), {"inertia_error"}, {"hysteresis"}]})
+    rates = det.wrong_name_rates(table)
+    assert rates == {"inertia_error": (2, 4), "unmodelled_mode": (1, 5), "hysteresis": (0, 3)}
+    assert list(rates) == ["inertia_error", "unmodelled_mode", "hysteresis"]
+    assert det.wrong_name_rates(table.iloc[:0]) == {}
+
+
 def test_false_alarms(results):
     fa = det.false_alarms(results).set_index("baseline")
     assert (fa.loc["tanh", "scenarios"], fa.loc["tanh", "false_alarms"]) == (4, 1)

@@ -361,6 +361,33 @@ def test_a_term_whose_limits_fit_far_worse_is_told_from_them():
     assert apart_from_limits(_result("cubic_stiffness", 50.0), limits, cs) == {}
 
 
+def test_a_best_fit_on_a_limit_its_limits_fall_short_of_is_sampled_in_its_turn():
+    """confirm.mark_apart: hysteresis's best fit on delta_hyst's lower bound, its posterior
+    to pile there, is not held back as pulled where its limits' bounds fall short of its
+    Laplace gain by log(1/alpha); a bound of another parameter, or a limit within reach,
+    still pulls it."""
+    from harvester.diagnosis.name.confirm import ConfirmSettings, mark_apart, sampling_order
+    cs = ConfirmSettings()
+
+    def hysteresis(on_bound, gain=213.2):
+        s = _screened("hysteresis", 222.3)
+        s.laplace_gain, s.on_bound = gain, on_bound
+        return s
+
+    limits = {"sticking_friction": _screened("sticking_friction", 15.1),
+              "coulomb_friction": _screened("coulomb_friction", 1.7)}
+    fitted = {"hysteresis": hysteresis({"delta_hyst": ("lower", 40.0)}), **limits}
+    mark_apart(fitted, cs)
+    assert fitted["hysteresis"].apart == ("delta_hyst",) and not fitted["hysteresis"].pulled
+    assert sampling_order(["hysteresis", "coulomb_friction"], fitted)[1] == set()
+    other = {"hysteresis": hysteresis({"F_hyst": ("lower", 40.0)}), **limits}
+    mark_apart(other, cs)
+    assert other["hysteresis"].pulled == {"F_hyst": ("lower", 40.0)}
+    near = {"hysteresis": hysteresis({"delta_hyst": ("lower", 40.0)}, gain=16.0), **limits}
+    mark_apart(near, cs)
+    assert near["hysteresis"].apart == () and near["hysteresis"].pulled
+
+
 def test_laws_with_memory_are_screened_whatever_their_score():
     """rank.unprobed_rivals: hysteresis and the hysteretic spring, whose probes can miss a
     loop the record holds, are screened beside the ranked candidates where the structure can

@@ -376,6 +376,20 @@ def confusion_matrix(results: pd.DataFrame) -> pd.DataFrame:
     return table
 
 
+def wrong_name_rates(table: pd.DataFrame) -> dict[str, tuple[int, int]]:
+    """Issue 63's catch-all count, per term: (records whose flagging verdict names or ties it
+    where it is not a right name, records where it is not a right name), the most often
+    wrong first. ``table``: a row per record with ``said`` (the set of names a flagging
+    verdict gives, named or tied; empty otherwise) and ``right`` (the set of its right
+    names, :func:`accepted_names`: a term alike to a right one is right)."""
+    terms = sorted(set().union(*table["said"])) if len(table) else []
+    out = {}
+    for t in terms:
+        absent = table[[t not in r for r in table["right"]]]
+        out[t] = (int(sum(t in s for s in absent["said"])), len(absent))
+    return dict(sorted(out.items(), key=lambda kv: -kv[1][0] / max(kv[1][1], 1)))
+
+
 def false_alarms(results: pd.DataFrame, goal: float = GOAL_FALSE_ALARM_RATE) -> pd.DataFrame:
     """False-alarm rate on the effect-free scenarios, per baseline and overall (Wilson 95 %).
 

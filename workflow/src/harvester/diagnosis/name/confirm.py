@@ -473,6 +473,7 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
     deadline (``budget``) a candidate's TMCMC stops and no further one starts: each is
     appended to ``unfinished`` (``where``: the round, for its sentence)."""
     fitted = {s.effect: s for s in screen.candidates} if screen is not None else {}
+    mark_apart(fitted, settings)
     order, pulled = sampling_order(list(screen.order if screen is not None else effects),
                                    fitted)
     single = detection is not None and not (detection.significant or detection.conflict)
@@ -790,15 +791,13 @@ def apart_from_limits(result: CandidateResult, fitted: Mapping, settings: Confir
     could be named. On the frame the sticking law's best fit comes within it where the
     bristle is a stand-in. Returns ``limits_short``."""
     edges = {**result.at_prior_edge, **{n: "lower" for n in result.unresolved}}
-    limits = {o for n, s in edges.items() for o in term(result.effect).limit_terms(n, s)}
-    screens = [fitted.get(o) for o in sorted(limits)]
-    if not limits or any(s is None or s.failed or s.bound is None for s in screens):
-        return {}
+    limits = tuple(sorted({o for n, s in edges.items()
+                           for o in term(result.effect).limit_terms(n, s)}))
     least = result.delta_log_evidence - settings.base_threshold \
         - settings.mc_sigmas * result.delta_se
-    if max(s.bound for s in screens) >= least:
+    if not _short(limits, fitted, least):
         return {}
-    result.limits_short = {s.effect: float(s.bound) for s in screens}
+    result.limits_short = {o: float(fitted[o].bound) for o in limits}
     result.accepted = bool(result.delta_log_evidence > result.threshold
                            and not result.untrusted_edges and not result.unshown
                            and not result.contradicted)
@@ -807,6 +806,28 @@ def apart_from_limits(result: CandidateResult, fitted: Mapping, settings: Confir
                                                      result.limits_short.items()),
              result.delta_log_evidence)
     return result.limits_short
+
+
+def mark_apart(fitted: Mapping, settings: ConfirmSettings) -> None:
+    """Set ``Screened.apart`` on each screened candidate (``fitted``: effect -> Screened)
+    whose best fit lies on a bound where its term becomes other terms (``Term.limits``), each
+    of them screened with a usable fit whose evidence bound falls short of the candidate's
+    Laplace gain by more than log(1/alpha): its posterior may pile there and it is still
+    judged (:func:`apart_from_limits`), so it is sampled in its turn, not last or never."""
+    for s in fitted.values():
+        if s.failed:
+            continue
+        least = s.laplace_gain - settings.base_threshold
+        s.apart = tuple(n for n, (side, _) in s.on_bound.items()
+                        if _short(term(s.effect).limit_terms(n, side), fitted, least))
+
+
+def _short(limits: tuple[str, ...], fitted: Mapping, least: float) -> bool:
+    """Whether every one of ``limits`` was screened with a usable best fit whose evidence
+    bound lies below ``least``."""
+    screens = [fitted.get(o) for o in limits]
+    return bool(limits) and all(x is not None and not x.failed and x.bound is not None
+                                and x.bound < least for x in screens)
 
 
 def budget_rivals(results: list[CandidateResult], fitted: Mapping, settings: ConfirmSettings

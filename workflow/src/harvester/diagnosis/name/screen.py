@@ -140,12 +140,17 @@ class Screened:
     #: the likelihood's smoothness about the MAP (``smoothness.Smoothness``), checked before
     #: TMCMC (``confirm.rough``); None where it was not
     smooth: object = None
+    #: parameters on a bound where the term becomes its limits, which the round's screens
+    #: tell it from (``confirm.mark_apart``): a posterior piled there is still judged
+    apart: tuple[str, ...] = ()
 
     @property
     def pulled(self) -> dict[str, tuple[str, float]]:
         """Those of ``on_bound`` whose posterior must pile against the bound (a fall above
-        PILE_NATS)."""
-        return {n: v for n, v in self.on_bound.items() if v[1] > PILE_NATS}
+        PILE_NATS), but for a bound where the term becomes limits it is told from
+        (``apart``)."""
+        return {n: v for n, v in self.on_bound.items()
+                if v[1] > PILE_NATS and n not in self.apart}
 
     def importance_draws(self, n: int, seed: int) -> np.ndarray:
         """n draws of the candidate's posterior from its importance-sampling estimate
