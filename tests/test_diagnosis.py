@@ -294,13 +294,13 @@ def _result(effect, delta, se=0.3, accepted=True):
 
 
 def test_a_rival_the_budget_left_unsampled_that_could_reach_the_name_makes_a_tie():
-    """confirm.budget_rivals: the literature generator's LuGre record as force -> rel_disp
+    """skips.budget_rivals: the literature generator's LuGre record as force -> rel_disp
     named a mode (+97.8 nats) while hysteresis, its best fit's bound +104.7, was left
     unsampled by the budget: the mode is not named alone. A rival whose bound cannot reach
     the name less the margin, one of the same physics, or one skipped for another reason
     leaves the name standing."""
-    from harvester.diagnosis.name.confirm import (BUDGET_REASON, STOPPED_REASON,
-                                                   ConfirmSettings, budget_rivals)
+    from harvester.diagnosis.name.confirm import ConfirmSettings
+    from harvester.diagnosis.name.skips import BUDGET_REASON, STOPPED_REASON, budget_rivals
     cs = ConfirmSettings()
 
     def screened(effect, bound, skipped):
@@ -326,13 +326,14 @@ def test_a_rival_the_budget_left_unsampled_that_could_reach_the_name_makes_a_tie
 
 
 def test_a_term_whose_limits_fit_far_worse_is_told_from_them():
-    """confirm.apart_from_limits: hysteresis unresolved (1.08 um below the 8.3 um the record
+    """limits.apart_from_limits: hysteresis unresolved (1.08 um below the 8.3 um the record
     resolves) and piled on its lower bound is accepted where its limits, both screened, fall
     short of it by more than the naming margin (the Bouc-Wen friction as base_disp ->
     rel_disp: +212.3 against +15.1 and +1.7); not where one comes within the margin (the
     frame's stand-in bristle), was not screened, or failed; an edge of another parameter
     still leaves it untrusted."""
-    from harvester.diagnosis.name.confirm import ConfirmSettings, apart_from_limits
+    from harvester.diagnosis.name.confirm import ConfirmSettings
+    from harvester.diagnosis.name.limits import apart_from_limits
     cs = ConfirmSettings()
 
     def hysteresis(delta=212.3, edges=None):
@@ -362,11 +363,13 @@ def test_a_term_whose_limits_fit_far_worse_is_told_from_them():
 
 
 def test_a_best_fit_on_a_limit_its_limits_fall_short_of_is_sampled_in_its_turn():
-    """confirm.mark_apart: hysteresis's best fit on delta_hyst's lower bound, its posterior
+    """limits.mark_apart: hysteresis's best fit on delta_hyst's lower bound, its posterior
     to pile there, is not held back as pulled where its limits' bounds fall short of its
     Laplace gain by log(1/alpha); a bound of another parameter, or a limit within reach,
     still pulls it."""
-    from harvester.diagnosis.name.confirm import ConfirmSettings, mark_apart, sampling_order
+    from harvester.diagnosis.name.confirm import ConfirmSettings
+    from harvester.diagnosis.name.limits import mark_apart
+    from harvester.diagnosis.name.skips import sampling_order
     cs = ConfirmSettings()
 
     def hysteresis(on_bound, gain=213.2):
@@ -537,7 +540,8 @@ def _screened(effect, bound, failed=False):
 
 
 def test_a_candidate_is_sampled_unless_its_evidence_bound_rules_it_out():
-    from harvester.diagnosis.name.confirm import ConfirmSettings, skip_reason
+    from harvester.diagnosis.name.confirm import ConfirmSettings
+    from harvester.diagnosis.name.skips import skip_reason
     cs = ConfirmSettings()  # acceptance at log(20) = 3.0 nats plus two standard errors
     assert skip_reason(None, [], cs, 3) is None                      # not screened: sampled
     assert skip_reason(_screened("end_stop", 2.0), [], cs, 3) is not None   # cannot pass
@@ -558,7 +562,10 @@ def test_acceptance_shares_alpha_among_the_candidates_the_round_could_name():
     from types import SimpleNamespace
 
 
-    from harvester.diagnosis.name.confirm import ConfirmSettings, judge, skip_reason
+    from harvester.diagnosis.name.confirm import ConfirmSettings, judge
+
+
+    from harvester.diagnosis.name.skips import skip_reason
     from harvester.inference.priors import PriorSpec
 
     one, family = ConfirmSettings(), ConfirmSettings(family=11)
@@ -586,7 +593,7 @@ def test_a_candidate_piled_where_it_stands_for_another_term_brings_that_term_in(
     # piled at its lower bound, where the law is Coulomb's
     from types import SimpleNamespace
 
-    from harvester.diagnosis.name.confirm import limit_candidates
+    from harvester.diagnosis.name.limits import limit_candidates
     from harvester.model.structures import structure
 
     tanh = structure("tanh")
@@ -607,7 +614,7 @@ def test_a_candidate_piled_where_it_stands_for_another_term_brings_that_term_in(
     assert limit_candidates("unmodelled_mode", mode.at_prior_edge, tanh,
                             ["unmodelled_mode"]) == []
     # and the term it becomes is that term's physics, not a rival explanation of it
-    from harvester.diagnosis.name.confirm import becomes
+    from harvester.diagnosis.name.limits import becomes
 
     other_side.at_limit, mode.at_limit = other_side.at_prior_edge, mode.at_prior_edge
     assert becomes(piled, "coulomb_friction") and becomes(piled, "sticking_friction")
@@ -617,7 +624,8 @@ def test_a_candidate_piled_where_it_stands_for_another_term_brings_that_term_in(
 
 
 def test_a_trusted_importance_estimate_rules_out_what_the_bound_cannot():
-    from harvester.diagnosis.name.confirm import ConfirmSettings, skip_reason
+    from harvester.diagnosis.name.confirm import ConfirmSettings
+    from harvester.diagnosis.name.skips import skip_reason
     from harvester.inference.importance import ImportanceEstimate
     cs = ConfirmSettings()
     mode = _screened("unmodelled_mode", 7.9)  # the bound alone would sample it
@@ -631,7 +639,8 @@ def test_a_trusted_importance_estimate_rules_out_what_the_bound_cannot():
 
 
 def test_a_failed_fit_is_sampled_only_where_a_trusted_importance_estimate_leaves_it_open():
-    from harvester.diagnosis.name.confirm import ConfirmSettings, skip_reason
+    from harvester.diagnosis.name.confirm import ConfirmSettings
+    from harvester.diagnosis.name.skips import skip_reason
     from harvester.inference.importance import ImportanceEstimate
     cs = ConfirmSettings()
     stop = _screened("backlash", -300.0, failed=True)  # its bound means nothing
@@ -768,7 +777,8 @@ def test_a_candidate_pulled_against_a_bound_is_sampled_last_and_only_to_tie() ->
     """A candidate whose best fit lies on a bound its posterior must pile against cannot be
     named (``judge`` does not trust it): it is sampled after the others, and only where a
     candidate accepted before it leaves a tie to make."""
-    from harvester.diagnosis.name.confirm import ConfirmSettings, sampling_order, skip_reason
+    from harvester.diagnosis.name.confirm import ConfirmSettings
+    from harvester.diagnosis.name.skips import sampling_order, skip_reason
     cs = ConfirmSettings()
     mode, asym, cubic = (_screened("unmodelled_mode", 167.0), _screened("asymmetric_friction",
                                                                          93.0),

@@ -88,8 +88,8 @@ def test_a_mass_error_that_triples_the_weighed_mass_contradicts_it() -> None:
 def test_a_candidate_whose_device_contradicts_the_sidecar_is_not_accepted() -> None:
     """confirm.judge: a mass error with the evidence to be accepted but M tripled is refused
     (``refused_for_device``), ties with nothing and does not use up the round's top."""
-    from harvester.diagnosis.name.confirm import (CandidateResult, ConfirmSettings, judge,
-                                             mark_ties, skip_reason)
+    from harvester.diagnosis.name.confirm import CandidateResult, ConfirmSettings, judge, mark_ties
+    from harvester.diagnosis.name.skips import skip_reason
     from harvester.inference.priors import PriorSpec
     known = {"M": 20.0, "m": 15.0, "k": 2000.0}
     s, draws = _mass_error_draws(57.2, 0.5)

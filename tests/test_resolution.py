@@ -1,5 +1,5 @@
 """A pre-sliding displacement the record does not resolve is not named as pre-sliding
-(``diagnosis.name.confirm.unresolved``): below the smallest displacement the output tells from
+(``diagnosis.name.limits.unresolved``): below the smallest displacement the output tells from
 its noise, hysteresis is taken at its limit, dry friction that holds."""
 
 from __future__ import annotations
@@ -9,7 +9,9 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from harvester.diagnosis.name.confirm import CandidateResult, becomes, resolution, unresolved
+from harvester.diagnosis.name.confirm import CandidateResult
+
+from harvester.diagnosis.name.limits import becomes, resolution, unresolved
 from harvester.model.terms import term
 
 

@@ -149,7 +149,9 @@ def test_a_mode_above_the_likelihoods_band_is_not_named():
     is not named, said so, and leaves the round's top to the next; one inside it is named."""
     from types import SimpleNamespace
 
-    from harvester.diagnosis.name.confirm import ConfirmSettings, judge, skip_reason
+    from harvester.diagnosis.name.confirm import ConfirmSettings, judge
+
+    from harvester.diagnosis.name.skips import skip_reason
     from harvester.inference.priors import PriorSpec
     from harvester.model.structures import structure as named_structure
     s = named_structure("tanh+unmodelled_mode")
@@ -177,12 +179,14 @@ def test_a_mode_above_the_likelihoods_band_is_not_named():
 
 
 def test_a_mode_whose_best_fit_lies_above_the_band_is_not_sampled():
-    """confirm.skip_reason: a screened mode whose MAP puts f_mode above the likelihood's band
+    """skips.skip_reason: a screened mode whose MAP puts f_mode above the likelihood's band
     would not be named, so its TMCMC is not spent (the Bouc-Wen records' 104-218 Hz); the same
     fit with f_mode inside the band is sampled."""
     from types import SimpleNamespace
 
-    from harvester.diagnosis.name.confirm import ConfirmSettings, skip_reason
+    from harvester.diagnosis.name.confirm import ConfirmSettings
+
+    from harvester.diagnosis.name.skips import skip_reason
     from harvester.diagnosis.name.screen import Screened
     names = ("k", "f_mode", "zeta_mode", "mass_mode", "drive_base", "sigma")
 

@@ -58,15 +58,14 @@ import numpy as np
 
 from harvester.inference.map_fit import ChainProblem, chain_problem
 from harvester.diagnosis.detect.scores import Detection, at_prior_edge
-from harvester.diagnosis.name.fits import (BRIDGE_MIN_SE, MISSED_MODE_NATS, ModelFit, candidate_priors,
-                                      prior_dict, scan_factor)
+from harvester.diagnosis.name.fits import (MISSED_MODE_NATS, ModelFit, candidate_priors,
+                                           prior_dict, scan_factor)
 from harvester.diagnosis.name.budget import OutOfTime, Unfinished, spent
-from harvester.diagnosis.name.screen import Screen, above_band
+from harvester.diagnosis.name.screen import Screen
 from harvester.data.sidecar import DEFAULT_RELATIVE_SD
 from harvester.diagnosis.prepare.redundant import used_quantities
 from harvester.diagnosis.name.plausibility import (Implied, contradictions, implied_device,
                                               measured_device)
-from harvester.diagnosis.detect.signatures import candidate_terms
 from harvester.diagnosis.name.smoothness import smoothness
 from harvester.model.priors import DeviceScale
 from harvester.inference.evidence import BridgeEstimate, chains_bridge_log_evidence, log_target
@@ -78,10 +77,12 @@ from harvester.inference.priors import priors_for
 from harvester.inference.reference import (REFERENCE_SHARE, REFERENCE_WIDEN, GaussianFactor,
                                            Reference, map_reference, support)
 from harvester.model.structures import ModelStructure
+from harvester.diagnosis.name.limits import (apart_from_limits, becomes, beyond_band,
+                                             limit_candidates, mark_apart, unresolved)
+from harvester.diagnosis.name.skips import (BUDGET_REASON, STOPPED_REASON, budget_rivals,
+                                            sampling_order, skip_reason)
 
 log = logging.getLogger("harvester.diagnosis")
-
-
 
 
 @dataclass(frozen=True)
@@ -116,10 +117,10 @@ class ConfirmSettings(TMCMCSettings):
     implied device is held against (``plausibility``).
 
     noise_floor: the recording's own noise floor (output units, ``detect.floor``; None where
-    none is measured): a term's displacement below it (:func:`unresolved`) is not named.
+    none is measured): a term's displacement below it (``limits.unresolved``) is not named.
 
     candidates: the library terms the diagnosis may try (None: all), also where a candidate
-    stands for another at a bound (:func:`limit_candidates`).
+    stands for another at a bound (``limits.limit_candidates``).
     """
 
     particles: int = 300
@@ -171,15 +172,15 @@ class CandidateResult:
     #: the stated device quantities its posterior implies (``plausibility``)
     device: list[Implied] = field(default_factory=list)
     #: displacements of the term the record does not resolve: name -> (posterior median,
-    #: the record's resolution), both m (:func:`unresolved`)
+    #: the record's resolution), both m (``limits.unresolved``)
     unresolved: dict[str, tuple[float, float]] = field(default_factory=dict)
     #: its resonances above the band the likelihood compares: name -> (posterior median, the
-    #: band's top), both Hz (:func:`beyond_band`)
+    #: band's top), both Hz (``limits.beyond_band``)
     beyond_band: dict[str, tuple[float, float]] = field(default_factory=dict)
     seconds: float = 0.0  # wall time of its confirmation (TMCMC, or the estimate it rests on)
     #: the terms it would stand for at its unresolved or piled lower limits, each screened
     #: and short of its gain by more than the naming margin: term -> evidence bound, nats
-    #: (:func:`apart_from_limits`); the record then tells the law from them by its force
+    #: (``limits.apart_from_limits``); the record then tells the law from them by its force
     limits_short: dict[str, float] = field(default_factory=dict)
 
     def _told(self, name: str, side: str) -> bool:
@@ -467,7 +468,7 @@ def confirm(baseline: ModelFit, effects: list[str], priors: Mapping[str, PriorSp
     ``detection``: the round's detection, whose scans place the start of candidates with a
     ``Probe.start_shape`` (:func:`candidate_reference`). ``screen``: the candidates' best
     fits (``diagnosis.name.screen``); then they are sampled in its order, at most ``top`` of them,
-    and one whose evidence bound rules it out is not sampled (:func:`skip_reason`). Those
+    and one whose evidence bound rules it out is not sampled (``skips.skip_reason``). Those
     whose best fit lies on a bound their posterior must pile against (``Screened.pulled``)
     come last: they can only tie with a candidate accepted before them. Past the settings'
     deadline (``budget``) a candidate's TMCMC stops and no further one starts: each is
@@ -534,11 +535,6 @@ def _sampled(baseline: ModelFit, effect: str, screened, priors: Mapping[str, Pri
     if screened is not None:
         screened.sampled = True
     return result
-
-
-#: Why a candidate the time budget left was not sampled, or why its sampling stopped.
-BUDGET_REASON = "the time budget ran out before it"
-STOPPED_REASON = "not finished within the time budget"
 
 
 def _skip(screened, effect: str, reason: str, pulled: bool, structure: ModelStructure,
@@ -653,214 +649,6 @@ def rough_reason(screened) -> str:
             "estimate here confirms")
 
 
-def sampling_order(order: list[str], fitted: Mapping) -> tuple[list[str], set[str]]:
-    """``order`` with the candidates whose best fit lies on a bound their posterior must pile
-    against (``Screened.pulled``, of ``fitted``: effect -> Screened) moved behind the others,
-    each group in its order; and the set of those."""
-    pulled = {e for e in order if e in fitted and fitted[e].pulled and not fitted[e].failed}
-    return [e for e in order if e not in pulled] + [e for e in order if e in pulled], pulled
-
-
-def limit_candidates(effect: str, edges: Mapping[str, str], structure: ModelStructure,
-                     order: list[str], candidates: tuple[str, ...] | None = None) -> list[str]:
-    """The terms a candidate stands for where its posterior piled, or its best fit lies,
-    against a bound (``edges``: name -> side; ``Term.limits``), that the structure can take
-    (of ``candidates``, None: any) and the round has not listed: sampled next, in its place
-    (unscreened, so always)."""
-    allowed = set(candidate_terms(structure.terms, candidates))
-    out = []
-    for name, side in edges.items():
-        other = next((o for o in term(effect).limit_terms(name, side) if o in allowed), None)
-        if other and other not in order and other not in out:
-            log.info("%s: %s at its %s limit, where the term stands for %s: sampling %s too",
-                     effect, name, side, other, other)
-            out.append(other)
-    return out
-
-
-def skip_reason(screened, results: list[CandidateResult], settings: ConfirmSettings,
-                top: int | None, nested_se: float = BRIDGE_MIN_SE,
-                single_scores: bool = False, estimate: bool = True) -> str | None:
-    """Why a screened candidate (``diagnosis.name.screen.Screened``) need not be sampled: ``top``
-    candidates were sampled already, or its evidence bound (``Screened.bound``) or its
-    importance-sampling ceiling (``Screened.importance_ceiling``, where trusted) lies below the
-    acceptance threshold (``acceptance_base`` plus mc_sigmas times the root sum of squares of
-    the nested model's standard error and BRIDGE_MIN_SE), or below the best accepted gain minus
-    the naming margin (log(1/alpha) + mc_sigmas standard errors of that gain): it can then
-    neither be accepted nor tie with the best. A candidate whose fit failed (fell below the
-    nested model's: an optimiser that missed, or an effect whose smallest admissible size
-    already costs) is sampled only where a trusted importance-sampling estimate, which does
-    not rest on the fit, leaves it open: nothing else supports it, and its sampling is where
-    stiff contacts spend a quarter of an hour (the backlash on the literature grid, never
-    accepted). In a round opened by single effects' scores (``single_scores``: the family's
-    test not significant, no conflict), or once another candidate was accepted, it is not
-    even estimated. A candidate whose best fit lies on a bound its posterior must pile
-    against (``Screened.pulled``) would not be trusted (:func:`judge`), so it cannot be
-    named; it is sampled only where a candidate accepted before it leaves it a tie to make.
-    One whose best fit puts a resonance above the likelihood's band
-    (``Screened.beyond_band``) would not be named either (:func:`beyond_band`): on the
-    literature generator's Bouc-Wen records a mode's TMCMC at 104-218 Hz above the 81.9 Hz
-    band spent the time budget before the other candidates were sampled. None: sample it
-    (always where it was not screened). ``estimate`` False: the reasons that need no
-    importance-sampling estimate only (the time budget is spent)."""
-    if screened is None:
-        return None
-    if top is not None and len([r for r in results
-                                if not (r.contradicted or r.unshown)]) >= top:
-        return f"the round's {top} best by their fits were sampled"
-    if screened.pulled and not screened.failed and not any(r.accepted for r in results):
-        return (f"its best fit has {screened.pull_phrase()}: its posterior would pile there "
-                "and not be trusted, and no candidate was accepted for it to tie with")
-    above = screened.beyond_band
-    if above and not screened.failed:
-        at = ", ".join(f"{n} at {x:.1f} Hz" for n, (x, _) in above.items())
-        band = max(b for _, b in above.values())
-        return (f"its best fit puts {at}, above the {band:.1f} Hz band the likelihood "
-                "compares: a resonance the record does not show, which is not named")
-    least = settings.acceptance_base + settings.mc_sigmas * float(np.hypot(nested_se,
-                                                                           BRIDGE_MIN_SE))
-    if screened.failed:  # its bound means nothing; a trusted estimate still does
-        return _failed_fit_reason(screened, results, settings, least, single_scores, estimate)
-    return _fitted_reason(screened, results, settings, least, estimate)
-
-
-def _failed_fit_reason(screened, results: list[CandidateResult], settings: ConfirmSettings,
-                       least: float, single_scores: bool, estimate: bool = True) -> str | None:
-    """:func:`skip_reason` for a candidate whose fit fell below the nested model's: only a
-    trusted importance-sampling estimate, and only in a round opened by the family's test
-    with nothing accepted yet, can leave it open (``least``: the acceptance threshold)."""
-    if single_scores:
-        return ("its fit fell below the nested model's, and the round was opened by single "
-                "effects' scores, not by the family's test")
-    accepted = [r.effect for r in results if r.accepted]
-    if accepted:  # not estimated either (100 s for a stiff contact): the next round
-        return (f"its fit fell below the nested model's and {accepted[0]} was accepted; "
-                "the next round screens it again")
-    if not estimate:
-        return None
-    ceiling = screened.importance_ceiling(settings.mc_sigmas)
-    if ceiling is None:
-        return (f"its fit fell below the nested model's and {screened.importance_phrase()}"
-                ": nothing supports it (the next round screens it again)")
-    if ceiling < least:
-        return (f"its fit fell below the nested model's; {screened.importance_phrase()}, "
-                f"at most {ceiling:.1f}, below the acceptance threshold {least:.1f}")
-    return None
-
-
-def _fitted_reason(screened, results: list[CandidateResult], settings: ConfirmSettings,
-                   least: float, estimate: bool = True) -> str | None:
-    """:func:`skip_reason` for a candidate with a usable fit: its evidence bound, then its
-    trusted importance-sampling ceiling, against the acceptance threshold ``least`` and the
-    best accepted gain less the naming margin."""
-    if screened.bound < least:
-        return (f"its best fit gains at most {screened.bound:.1f} nats of evidence, below the "
-                f"acceptance threshold {least:.1f}")
-    accepted = [r for r in results if r.accepted]
-    floor = -np.inf
-    if accepted:
-        best = max(accepted, key=lambda r: r.delta_log_evidence)
-        floor = best.delta_log_evidence - settings.base_threshold \
-            - settings.mc_sigmas * best.delta_se
-        if screened.bound < floor:
-            return (f"its best fit gains at most {screened.bound:.1f} nats of evidence; "
-                    f"{best.effect} gained {best.delta_log_evidence:.1f}")
-    if not estimate:
-        return None
-    ceiling = screened.importance_ceiling(settings.mc_sigmas)
-    if ceiling is not None and ceiling < max(least, floor):
-        return (f"{screened.importance_phrase()}, at most {ceiling:.1f}, below "
-                + (f"the acceptance threshold {least:.1f}" if floor <= least else
-                   f"{best.effect}'s {best.delta_log_evidence:.1f} less the naming margin"))
-    return None
-
-
-def apart_from_limits(result: CandidateResult, fitted: Mapping, settings: ConfirmSettings
-                      ) -> dict[str, float]:
-    """Where the candidate stands for other terms at a bound (a pre-sliding displacement the
-    record does not resolve, or piled on its prior's lower bound: ``Term.limits``), whether
-    the record still tells it from them: each of those terms screened this round
-    (``fitted``: effect -> Screened) with a usable best fit whose evidence bound falls short
-    of the candidate's gain by more than the naming margin (log(1/alpha) + mc_sigmas of its
-    standard error). The law is then not its limit: its force, not its displacement, tells
-    it apart, and that displacement is an upper bound, not a value. Sets
-    ``result.limits_short`` (term -> bound) and, where nothing else holds it back, accepts
-    it. On the literature generator's Bouc-Wen friction as base_disp -> rel_disp (pre-sliding
-    1.7 um, the record resolving 8.3 um) hysteresis gained +212.3 nats, piled at 1.08 um,
-    its limits' best fits +15.1 (sticking) and +1.7 (Coulomb): taken as its limit, neither
-    could be named. On the frame the sticking law's best fit comes within it where the
-    bristle is a stand-in. Returns ``limits_short``."""
-    edges = {**result.at_prior_edge, **{n: "lower" for n in result.unresolved}}
-    limits = tuple(sorted({o for n, s in edges.items()
-                           for o in term(result.effect).limit_terms(n, s)}))
-    least = result.delta_log_evidence - settings.base_threshold \
-        - settings.mc_sigmas * result.delta_se
-    if not _short(limits, fitted, least):
-        return {}
-    result.limits_short = {o: float(fitted[o].bound) for o in limits}
-    result.accepted = bool(result.delta_log_evidence > result.threshold
-                           and not result.untrusted_edges and not result.unshown
-                           and not result.contradicted)
-    log.info("%s: its limits' best fits (%s) fall short of its %+.1f nats: the record tells "
-             "it from them", result.effect, ", ".join(f"{e} {b:+.1f}" for e, b in
-                                                     result.limits_short.items()),
-             result.delta_log_evidence)
-    return result.limits_short
-
-
-def mark_apart(fitted: Mapping, settings: ConfirmSettings) -> None:
-    """Set ``Screened.apart`` on each screened candidate (``fitted``: effect -> Screened)
-    whose best fit lies on a bound where its term becomes other terms (``Term.limits``), each
-    of them screened with a usable fit whose evidence bound falls short of the candidate's
-    Laplace gain by more than log(1/alpha): its posterior may pile there and it is still
-    judged (:func:`apart_from_limits`), so it is sampled in its turn, not last or never."""
-    for s in fitted.values():
-        if s.failed:
-            continue
-        least = s.laplace_gain - settings.base_threshold
-        s.apart = tuple(n for n, (side, _) in s.on_bound.items()
-                        if _short(term(s.effect).limit_terms(n, side), fitted, least))
-
-
-def _short(limits: tuple[str, ...], fitted: Mapping, least: float) -> bool:
-    """Whether every one of ``limits`` was screened with a usable best fit whose evidence
-    bound lies below ``least``."""
-    screens = [fitted.get(o) for o in limits]
-    return bool(limits) and all(x is not None and not x.failed and x.bound is not None
-                                and x.bound < least for x in screens)
-
-
-def budget_rivals(results: list[CandidateResult], fitted: Mapping, settings: ConfirmSettings
-                  ) -> list[str]:
-    """The best accepted candidate is not named alone where the time budget left a screened
-    rival of other physics unsampled (or stopped its TMCMC) whose best fit could reach it: its
-    evidence bound at least the best's gain less the naming margin, so that sampled it could
-    tie or lead (``skip_reason`` would have sampled it). Such rivals are recorded as
-    indistinguishable from it, the evidence on them not in; a candidate whose best fit failed
-    or puts a resonance above the band is not one. On the literature generator's LuGre record
-    as force -> rel_disp a mode was named (+97.8 nats) while hysteresis, its bound +104.7,
-    was left unsampled by the budget. Returns the rivals added. ``results`` best first."""
-    accepted = [r for r in results if r.accepted]
-    if not accepted:
-        return []
-    best = accepted[0]
-    least = best.delta_log_evidence - settings.base_threshold \
-        - settings.mc_sigmas * best.delta_se
-    added = []
-    for s in fitted.values():
-        cut = s.skipped is not None and (s.skipped == BUDGET_REASON
-                                         or s.skipped.startswith(STOPPED_REASON))
-        if cut and not s.failed and not s.beyond_band and s.bound >= least \
-                and not same_physics(s.effect, best.effect) \
-                and s.effect not in best.indistinguishable_from:
-            best.indistinguishable_from.append(s.effect)
-            added.append(s.effect)
-    if added:
-        log.info("%s not named alone: the time budget left %s unsampled, whose best fits "
-                 "could reach its evidence", best.effect, ", ".join(added))
-    return added
-
-
 def decisions(baseline: ModelFit, results: list[CandidateResult], settings: ConfirmSettings
               ) -> tuple[float, ...]:
     """Log evidences at which a candidate's fate changes: acceptance over the baseline (by
@@ -907,46 +695,6 @@ def judge(effect: str, fit: ModelFit, baseline: ModelFit, settings: ConfirmSetti
     return result
 
 
-def resolution(fit: ModelFit, noise_floor: float) -> float:
-    """The smallest displacement (m) the record tells from its noise: the recording's own
-    noise floor (RMS over the likelihood's band, output units, ``detect.floor``: measured
-    where the model has no say, so that a model's misfit does not set it) carried to a
-    displacement at the top of that band (floor / (2 pi f)^order: the displacement itself,
-    or its second derivative). Below it a displacement of the model leaves nothing in the
-    record but the noise."""
-    order = fit.problem.output_type.order
-    return float(noise_floor) / (2.0 * np.pi * fit.problem.band_hz) ** order
-
-
-def unresolved(effect: str, fit: ModelFit, noise_floor: float | None
-               ) -> dict[str, tuple[float, float]]:
-    """The term's displacements (``Term.resolved``: a pre-sliding displacement) whose
-    posterior median lies below what the record resolves (:func:`resolution`): name ->
-    (median, resolution), m. Such a term is a stand-in for its limit (a bristle of 0.1 um on
-    lasers that see 5 um is a contact that holds), not its own physics. None checked where
-    the record's noise floor is not measured (``noise_floor`` None)."""
-    names = [n for n in term(effect).resolved if n in fit.names]
-    if not names or noise_floor is None:
-        return {}
-    floor = resolution(fit, noise_floor)
-    medians = {n: float(np.median(fit.samples[:, fit.names.index(n)])) for n in names}
-    return {n: (x, floor) for n, x in medians.items() if x < floor}
-
-
-def beyond_band(effect: str, fit: ModelFit) -> dict[str, tuple[float, float]]:
-    """The term's resonance frequencies (``Term.in_band``) whose posterior median lies above
-    the band the likelihood compares (``ChainProblem.band_hz``): name -> (median, band top),
-    Hz. The record holds no peak there, only what the resonance's skirt does at the band's
-    top; on the literature generator's records recorded as base_disp -> rel_acc, whose base
-    acceleration is derived through a filter at 102 Hz, a mode was fitted at 83-109 Hz above
-    the 81.9 Hz band on four of the eight effects (dead zone, ground friction, Dahl,
-    backlash), and named on two (December 2026, 3289362): the filter's edge, not a part of the
-    device."""
-    return above_band(effect, fit.names,
-                      lambda n: np.median(fit.samples[:, fit.names.index(n)]),
-                      lambda: fit.problem.band_hz)
-
-
 def candidate_device(effect: str, fit: ModelFit, settings: ConfirmSettings) -> list[Implied]:
     """The stated device quantities (the fit's known M, m, k, with ``settings``'
     uncertainties) that ``effect``'s posterior implies (``plausibility``); none where its
@@ -961,17 +709,10 @@ def candidate_device(effect: str, fit: ModelFit, settings: ConfirmSettings) -> l
                           {n: v for n, v in stated.items() if n in used})
 
 
-def becomes(result: CandidateResult, effect: str) -> bool:
-    """Whether ``result``'s posterior piles against a bound where its term becomes
-    ``effect`` (``Term.limits``): a mode pushed far above the band is the mass error."""
-    return any(effect in term(result.effect).limit_terms(name, side)
-               for name, side in result.at_limit.items())
-
-
 def mark_ties(results: list[CandidateResult], settings: ConfirmSettings) -> None:
     """The best accepted candidate is named alone only if every physically different
     candidate (``harvester.model.terms.same_physics``; not one piled at the bound where it
-    becomes the best's term, :func:`becomes`) trails it by more than the naming margin
+    becomes the best's term, ``limits.becomes``) trails it by more than the naming margin
     (log(1/alpha) plus mc_sigmas standard errors of the gap: two named models, no family);
     the others within it are recorded as indistinguishable from it, both ways. ``results``
     best first."""

@@ -23,7 +23,7 @@ as the nested model's sampled evidence:
 
 A candidate whose ``bound`` lies below the acceptance threshold cannot be accepted, and one
 whose bound lies below the best accepted gain minus the naming margin cannot tie with it
-(``confirm.skip_reason``): neither needs TMCMC. The bound misleads where the MAP misses the
+(``skips.skip_reason``): neither needs TMCMC. The bound misleads where the MAP misses the
 best fit: the fit starts from the best of the nested posterior's mean joined with prior draws
 of the added parameters and, for a start shape (a mode's frequency), the detection's scan; a
 fit below the nested model's best (impossible at the optimum of a model that contains the
@@ -141,7 +141,7 @@ class Screened:
     #: TMCMC (``confirm.rough``); None where it was not
     smooth: object = None
     #: parameters on a bound where the term becomes its limits, which the round's screens
-    #: tell it from (``confirm.mark_apart``): a posterior piled there is still judged
+    #: tell it from (``limits.mark_apart``): a posterior piled there is still judged
     apart: tuple[str, ...] = ()
 
     @property
@@ -167,7 +167,7 @@ class Screened:
     def beyond_band(self) -> dict[str, tuple[float, float]]:
         """The term's resonance frequencies (``Term.in_band``) whose best fit lies above the
         band the likelihood compares: name -> (MAP, band top), Hz. The confirmation would not
-        name the term with its posterior there (``confirm.beyond_band``), so its sampling
+        name the term with its posterior there (``limits.beyond_band``), so its sampling
         would buy no name."""
         if self.problem is None:
             return {}

@@ -176,14 +176,14 @@ class Term:
     ``resolved``: parameters that are displacements (m) the record must resolve for the term
     to be its physics (a pre-sliding displacement): where the posterior puts one below the
     smallest displacement the record tells from its noise, the term is taken at that
-    parameter's lower limit (``limits``), not named (``diagnosis.name.confirm.unresolved``).
+    parameter's lower limit (``limits``), not named (``diagnosis.name.limits.unresolved``).
     ``unprobed``: the score test cannot see the term (a law with memory: its probe's loop,
     at a guessed pre-sliding displacement and a small strength, can point away from a loop
     the record holds), so the first round screens its best fit wherever the structure can
     take it (``diagnosis.name.rank.unprobed_rivals``).
     ``in_band``: parameters that are frequencies (Hz) of a resonance the record must show:
     where the posterior puts one above the band the likelihood compares, the record holds no
-    peak of it and the term is not named (``diagnosis.name.confirm.beyond_band``).
+    peak of it and the term is not named (``diagnosis.name.limits.beyond_band``).
     ``static`` (a ``stick`` term): its share of the holding level (N), a function of its
     parameters. ``transition`` (a ``stick`` term whose law changes fast at low speed, a
     Stribeck decay): (speed, slope) = transition(*params), the speed (m/s) below which the
