@@ -20,7 +20,8 @@ import time
 import numpy as np
 
 from harvester.inference.map_fit import chain_problem
-from harvester.diagnosis.name.confirm import ConfirmSettings, bridge_evidence
+from harvester.diagnosis.name.confirm import bridge_evidence
+from harvester.diagnosis.name.results import ConfirmSettings
 from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
 from harvester.inference.identify import identify
 from harvester.inference.problems import make_problem

@@ -25,7 +25,8 @@ import yaml
 
 from harvester.grid.scoring import SIGMA_PRIOR
 from harvester.inference.map_fit import baseline_state, chain_problem, fit_map
-from harvester.diagnosis.name.confirm import ConfirmSettings, confirm, fit_structure
+from harvester.diagnosis.name.confirm import confirm, fit_structure
+from harvester.diagnosis.name.results import ConfirmSettings
 from harvester.diagnosis.detect.scores import DetectionSettings, detect, estimate_temper
 from harvester.diagnosis.run import default_priors
 from harvester.diagnosis.detect.signatures import motion_scale

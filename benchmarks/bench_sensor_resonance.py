@@ -27,7 +27,7 @@ import time
 
 from harvester.diagnosis.detect.quick import quick_detect
 from harvester.diagnosis.detect.scores import band_top
-from harvester.diagnosis.name.confirm import ConfirmSettings
+from harvester.diagnosis.name.results import ConfirmSettings
 from harvester.diagnosis.name.sensor import MODE, read_resonance
 from harvester.diagnosis.prepare.settings import DiagnosisSettings
 from harvester.inference.map_fit import fit_map

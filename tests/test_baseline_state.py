@@ -54,14 +54,14 @@ def test_no_simulable_draw_is_a_named_error(problem):
 
 
 def result(effect: str, problem: ChainProblem, samples: np.ndarray, gain: float):
-    from harvester.diagnosis.name.confirm import CandidateResult
+    from harvester.diagnosis.name.results import CandidateResult
     from harvester.diagnosis.name.fits import ModelFit
     fit = ModelFit(problem.structure, problem, samples, np.array([gain, gain]))
     return CandidateResult(effect, fit, gain, 0.5, 6.0, True)
 
 
 def test_divergent_accepted_candidate_withdrawn(problem):
-    from harvester.diagnosis.name.confirm import ConfirmSettings
+    from harvester.diagnosis.name.results import ConfirmSettings
     from harvester.diagnosis.name.simulable import withdraw_divergent
     far = draws([-1e7, -2e7, 0.0], [C_M, C_M, C_M])  # 1 of 3 draws simulable
     near = draws([0.0, 1.0, -1.0], [C_M, C_M + 1.0, C_M - 1.0])

@@ -289,7 +289,7 @@ def test_candidate_priors_follow_the_device_from_the_papers_rig():
         4 * candidate_priors("quadratic_damping", rig)["c_quad"].upper * rig.v**2)
 
 def _result(effect, delta, se=0.3, accepted=True):
-    from harvester.diagnosis.name.confirm import CandidateResult
+    from harvester.diagnosis.name.results import CandidateResult
     return CandidateResult(effect, None, delta, se, 3.0 + 2 * se, accepted)
 
 
@@ -299,7 +299,7 @@ def test_a_rival_the_budget_left_unsampled_that_could_reach_the_name_makes_a_tie
     unsampled by the budget: the mode is not named alone. A rival whose bound cannot reach
     the name less the margin, one of the same physics, or one skipped for another reason
     leaves the name standing."""
-    from harvester.diagnosis.name.confirm import ConfirmSettings
+    from harvester.diagnosis.name.results import ConfirmSettings
     from harvester.diagnosis.name.skips import BUDGET_REASON, STOPPED_REASON, budget_rivals
     cs = ConfirmSettings()
 
@@ -332,7 +332,7 @@ def test_a_term_whose_limits_fit_far_worse_is_told_from_them():
     rel_disp: +212.3 against +15.1 and +1.7); not where one comes within the margin (the
     frame's stand-in bristle), was not screened, or failed; an edge of another parameter
     still leaves it untrusted."""
-    from harvester.diagnosis.name.confirm import ConfirmSettings
+    from harvester.diagnosis.name.results import ConfirmSettings
     from harvester.diagnosis.name.limits import apart_from_limits
     cs = ConfirmSettings()
 
@@ -367,7 +367,7 @@ def test_a_best_fit_on_a_limit_its_limits_fall_short_of_is_sampled_in_its_turn()
     to pile there, is not held back as pulled where its limits' bounds fall short of its
     Laplace gain by log(1/alpha); a bound of another parameter, or a limit within reach,
     still pulls it."""
-    from harvester.diagnosis.name.confirm import ConfirmSettings
+    from harvester.diagnosis.name.results import ConfirmSettings
     from harvester.diagnosis.name.limits import mark_apart
     from harvester.diagnosis.name.skips import sampling_order
     cs = ConfirmSettings()
@@ -403,7 +403,8 @@ def test_laws_with_memory_are_screened_whatever_their_score():
 
 
 def test_an_effect_is_named_alone_only_beyond_the_threshold_of_every_different_rival():
-    from harvester.diagnosis.name.confirm import ConfirmSettings, mark_ties
+    from harvester.diagnosis.name.confirm import mark_ties
+    from harvester.diagnosis.name.results import ConfirmSettings
     cs = ConfirmSettings()
     # a physically different rival 2 nats behind: a tie, both ways
     results = [_result("unmodelled_mode", 20.0), _result("inertia_error", 18.0)]
@@ -540,7 +541,7 @@ def _screened(effect, bound, failed=False):
 
 
 def test_a_candidate_is_sampled_unless_its_evidence_bound_rules_it_out():
-    from harvester.diagnosis.name.confirm import ConfirmSettings
+    from harvester.diagnosis.name.results import ConfirmSettings
     from harvester.diagnosis.name.skips import skip_reason
     cs = ConfirmSettings()  # acceptance at log(20) = 3.0 nats plus two standard errors
     assert skip_reason(None, [], cs, 3) is None                      # not screened: sampled
@@ -562,7 +563,10 @@ def test_acceptance_shares_alpha_among_the_candidates_the_round_could_name():
     from types import SimpleNamespace
 
 
-    from harvester.diagnosis.name.confirm import ConfirmSettings, judge
+    from harvester.diagnosis.name.confirm import judge
+
+
+    from harvester.diagnosis.name.results import ConfirmSettings
 
 
     from harvester.diagnosis.name.skips import skip_reason
@@ -624,7 +628,7 @@ def test_a_candidate_piled_where_it_stands_for_another_term_brings_that_term_in(
 
 
 def test_a_trusted_importance_estimate_rules_out_what_the_bound_cannot():
-    from harvester.diagnosis.name.confirm import ConfirmSettings
+    from harvester.diagnosis.name.results import ConfirmSettings
     from harvester.diagnosis.name.skips import skip_reason
     from harvester.inference.importance import ImportanceEstimate
     cs = ConfirmSettings()
@@ -639,7 +643,7 @@ def test_a_trusted_importance_estimate_rules_out_what_the_bound_cannot():
 
 
 def test_a_failed_fit_is_sampled_only_where_a_trusted_importance_estimate_leaves_it_open():
-    from harvester.diagnosis.name.confirm import ConfirmSettings
+    from harvester.diagnosis.name.results import ConfirmSettings
     from harvester.diagnosis.name.skips import skip_reason
     from harvester.inference.importance import ImportanceEstimate
     cs = ConfirmSettings()
@@ -777,7 +781,7 @@ def test_a_candidate_pulled_against_a_bound_is_sampled_last_and_only_to_tie() ->
     """A candidate whose best fit lies on a bound its posterior must pile against cannot be
     named (``judge`` does not trust it): it is sampled after the others, and only where a
     candidate accepted before it leaves a tie to make."""
-    from harvester.diagnosis.name.confirm import ConfirmSettings
+    from harvester.diagnosis.name.results import ConfirmSettings
     from harvester.diagnosis.name.skips import sampling_order, skip_reason
     cs = ConfirmSettings()
     mode, asym, cubic = (_screened("unmodelled_mode", 167.0), _screened("asymmetric_friction",

@@ -103,7 +103,8 @@ def test_evidence_acceptance_on_forced_candidates_at_most_5_percent():
     standard error sets a lower threshold than TMCMC's chain scatter did. Markov's bound
     (``confirm``) allows 5 %; at most one acceptance of the 16 comparisons passes."""
     from harvester.inference.map_fit import baseline_state, chain_problem, fit_map
-    from harvester.diagnosis.name.confirm import ConfirmSettings, confirm, fit_structure
+    from harvester.diagnosis.name.confirm import confirm, fit_structure
+    from harvester.diagnosis.name.results import ConfirmSettings
     from harvester.diagnosis.detect.scores import estimate_temper
     from harvester.diagnosis.run import default_priors
     from harvester.diagnosis.detect.signatures import motion_scale
@@ -137,7 +138,8 @@ def test_the_screens_bound_holds_and_its_laplace_estimate_tracks_the_evidence():
     of the gain lies within 10 nats of it, and the importance-sampling estimate, where
     trusted, within its stated error plus the screen's slack (IMPORTANCE_SLACK)."""
     from harvester.inference.map_fit import baseline_state, chain_problem, fit_map
-    from harvester.diagnosis.name.confirm import ConfirmSettings, candidate_fit, fit_structure
+    from harvester.diagnosis.name.confirm import candidate_fit, fit_structure
+    from harvester.diagnosis.name.results import ConfirmSettings
     from harvester.diagnosis.detect.scores import estimate_temper
     from harvester.diagnosis.run import default_priors
     from harvester.diagnosis.name.screen import IMPORTANCE_SLACK, screen

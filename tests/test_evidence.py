@@ -120,7 +120,8 @@ def test_the_diagnosis_evidence_agrees_with_tmcmc_and_is_more_precise():
     TMCMC's own chain-to-chain scatter of its pooled estimate, and its stated error is
     smaller than that scatter."""
     from harvester.inference.map_fit import chain_problem
-    from harvester.diagnosis.name.confirm import ConfirmSettings, fit_structure
+    from harvester.diagnosis.name.confirm import fit_structure
+    from harvester.diagnosis.name.results import ConfirmSettings
     from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
     from harvester.inference.problems import make_problem
     from harvester.inference.priors import PriorSpec

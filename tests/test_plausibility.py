@@ -88,7 +88,8 @@ def test_a_mass_error_that_triples_the_weighed_mass_contradicts_it() -> None:
 def test_a_candidate_whose_device_contradicts_the_sidecar_is_not_accepted() -> None:
     """confirm.judge: a mass error with the evidence to be accepted but M tripled is refused
     (``refused_for_device``), ties with nothing and does not use up the round's top."""
-    from harvester.diagnosis.name.confirm import CandidateResult, ConfirmSettings, judge, mark_ties
+    from harvester.diagnosis.name.confirm import judge, mark_ties
+    from harvester.diagnosis.name.results import CandidateResult, ConfirmSettings
     from harvester.diagnosis.name.skips import skip_reason
     from harvester.inference.priors import PriorSpec
     known = {"M": 20.0, "m": 15.0, "k": 2000.0}
@@ -207,7 +208,7 @@ def test_the_check_on_literature_records_a_true_mass_error_and_a_spring_mis_stat
 def test_a_refused_mass_error_is_said_in_the_headline_and_the_notes() -> None:
     """The rounds' refused candidate (its evidence enough, its device not) is not named: the
     headline says the furthest contradiction, the notes all of them and its evidence."""
-    from harvester.diagnosis.name.confirm import CandidateResult
+    from harvester.diagnosis.name.results import CandidateResult
     from harvester.diagnosis.name.rounds import Round
     from harvester.diagnosis.prepare.settings import DiagnosisSettings
     from harvester.diagnosis.name.verdict import conclude, judge

@@ -9,7 +9,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from harvester.diagnosis.name.confirm import CandidateResult
+from harvester.diagnosis.name.results import CandidateResult
 
 from harvester.diagnosis.name.limits import becomes, resolution, unresolved
 from harvester.model.terms import term

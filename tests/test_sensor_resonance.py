@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from harvester.data.signals import lowpass
-from harvester.diagnosis.name.confirm import CandidateResult, ConfirmSettings
+from harvester.diagnosis.name.results import CandidateResult, ConfirmSettings
 from harvester.diagnosis.name.fits import ModelFit
 from harvester.diagnosis.name.sensor import (fit_sensor, hold_against_sensor,
                                              read_resonance, sensor_response)
@@ -149,7 +149,9 @@ def test_a_mode_above_the_likelihoods_band_is_not_named():
     is not named, said so, and leaves the round's top to the next; one inside it is named."""
     from types import SimpleNamespace
 
-    from harvester.diagnosis.name.confirm import ConfirmSettings, judge
+    from harvester.diagnosis.name.confirm import judge
+
+    from harvester.diagnosis.name.results import ConfirmSettings
 
     from harvester.diagnosis.name.skips import skip_reason
     from harvester.inference.priors import PriorSpec
@@ -184,7 +186,7 @@ def test_a_mode_whose_best_fit_lies_above_the_band_is_not_sampled():
     fit with f_mode inside the band is sampled."""
     from types import SimpleNamespace
 
-    from harvester.diagnosis.name.confirm import ConfirmSettings
+    from harvester.diagnosis.name.results import ConfirmSettings
 
     from harvester.diagnosis.name.skips import skip_reason
     from harvester.diagnosis.name.screen import Screened

@@ -5,7 +5,14 @@
 ``rank``         the candidates ranked cheaply by their signatures
 ``screen``       the candidates' best fits (MAP), which bound the evidence each can gain
 ``smoothness``   whether a candidate's likelihood is smooth enough to sample
+``results``      a confirmation's settings and each candidate's result (its evidence, what
+                 holds it back from a name)
+``skips``        which screened candidates are sampled, in what order, and what the time
+                 budget left that could have reached a name
 ``confirm``      TMCMC of the augmented structures, their evidence, ties
+``limits``       where a candidate stands for another term (a bound of its prior, a
+                 displacement the record does not resolve, a resonance above the band), and
+                 where the record tells it from them
 ``budget``       the search's time budget: its deadline, what it left unfinished
 ``plausibility`` a candidate's implied device (masses, stiffness) against the sidecar's
                  measurements: a name whose device contradicts them is not given

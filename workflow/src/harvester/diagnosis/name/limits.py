@@ -15,18 +15,15 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Mapping
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from harvester.diagnosis.detect.signatures import candidate_terms
 from harvester.diagnosis.name.screen import above_band
 from harvester.model.structures import ModelStructure
+from harvester.diagnosis.name.fits import ModelFit
+from harvester.diagnosis.name.results import CandidateResult, ConfirmSettings
 from harvester.model.terms import term
-
-if TYPE_CHECKING:
-    from harvester.diagnosis.name.confirm import CandidateResult, ConfirmSettings
-    from harvester.diagnosis.name.fits import ModelFit
 
 log = logging.getLogger("harvester.diagnosis")
 

@@ -21,7 +21,8 @@ import numpy as np
 from harvester.diagnosis.prepare.analysis import Analysis, BaselineStart
 from harvester.inference.map_fit import BaselineState, baseline_state
 from harvester.diagnosis.name.budget import Unfinished, spent
-from harvester.diagnosis.name.confirm import CandidateResult, confirm, fit_structure
+from harvester.diagnosis.name.confirm import confirm, fit_structure
+from harvester.diagnosis.name.results import CandidateResult
 from harvester.diagnosis.name.fits import ModelFit
 from harvester.diagnosis.detect.floor import problem_floor
 from harvester.diagnosis.detect.scores import Detection, detect

@@ -50,7 +50,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize
 
-from harvester.diagnosis.name.confirm import CandidateResult, ConfirmSettings
+from harvester.diagnosis.name.results import ConfirmSettings
 from harvester.diagnosis.name.simulable import withdraw
 from harvester.inference.map_fit import BaselineState, ChainProblem, representative
 from harvester.model.structures import ModelStructure

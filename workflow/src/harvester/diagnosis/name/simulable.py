@@ -20,7 +20,9 @@ from collections.abc import Callable
 
 import numpy as np
 
-from harvester.diagnosis.name.confirm import CandidateResult, ConfirmSettings, mark_ties
+from harvester.diagnosis.name.confirm import mark_ties
+
+from harvester.diagnosis.name.results import CandidateResult, ConfirmSettings
 from harvester.inference.map_fit import ChainProblem
 from harvester.model.structures import ModelStructure
 

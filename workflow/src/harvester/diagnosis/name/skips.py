@@ -11,15 +11,12 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Mapping
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from harvester.diagnosis.name.fits import BRIDGE_MIN_SE
+from harvester.diagnosis.name.results import CandidateResult, ConfirmSettings
 from harvester.model.terms import same_physics
-
-if TYPE_CHECKING:
-    from harvester.diagnosis.name.confirm import CandidateResult, ConfirmSettings
 
 log = logging.getLogger("harvester.diagnosis")
 

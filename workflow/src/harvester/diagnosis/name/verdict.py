@@ -26,7 +26,7 @@ from dataclasses import dataclass, field, replace
 
 from harvester.data.units import SI, Units
 from harvester.diagnosis.name.budget import Unfinished
-from harvester.diagnosis.name.confirm import CandidateResult
+from harvester.diagnosis.name.results import CandidateResult
 from harvester.diagnosis.name.fits import ModelFit
 from harvester.diagnosis.detect.scores import Detection
 from harvester.diagnosis.detect.floor import Floor

@@ -7,7 +7,7 @@ from dataclasses import dataclass, replace
 
 from harvester.data.sidecar import DEFAULT_RELATIVE_SD, Sidecar
 from harvester.data.units import SI, Units, read_units
-from harvester.diagnosis.name.confirm import ConfirmSettings
+from harvester.diagnosis.name.results import ConfirmSettings
 from harvester.diagnosis.detect.scores import DetectionSettings
 from harvester.diagnosis.size.relevance import RelevanceFloor
 

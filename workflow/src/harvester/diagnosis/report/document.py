@@ -260,7 +260,7 @@ def _rounds(d) -> list[dict]:
     return [{"structure": rnd.structure, "p_value": rnd.detection.p_value,
              "significant": rnd.detection.significant,
              "prior_conflict": rnd.detection.conflict,
-             # the acceptance shares alpha among these (confirm.ConfirmSettings.family)
+             # the acceptance shares alpha among these (results.ConfirmSettings.family)
              "candidates_in_family": len(rnd.detection.candidates),
              "sampled": [r.effect for r in rnd.confirmed],
              "screened": ([s.to_dict() for s in rnd.screen.candidates]
