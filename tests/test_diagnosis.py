@@ -8,6 +8,7 @@ statistical checks over many seeds are in test_diagnosis_calibration.py (slow).
 from __future__ import annotations
 
 import logging
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -360,21 +361,28 @@ def test_a_term_whose_limits_fit_far_worse_is_told_from_them():
     assert apart_from_limits(other, limits, cs) and not other.accepted
     assert other.untrusted_edges == {"F_hyst": "lower"}
     assert apart_from_limits(_result("cubic_stiffness", 50.0), limits, cs) == {}
+    resolved = hysteresis()  # piled on the bound of a displacement the record resolves
+    resolved.unresolved = {}
+    assert apart_from_limits(resolved, limits, cs) == {} and resolved.untrusted_edges
 
 
 def test_a_best_fit_on_a_limit_its_limits_fall_short_of_is_sampled_in_its_turn():
     """limits.mark_apart: hysteresis's best fit on delta_hyst's lower bound, its posterior
     to pile there, is not held back as pulled where its limits' bounds fall short of its
-    Laplace gain by log(1/alpha); a bound of another parameter, or a limit within reach,
-    still pulls it."""
+    Laplace gain by log(1/alpha) and the bound lies below what the record resolves; a bound
+    of another parameter, one above the resolution, a limit within reach, or a record whose
+    noise floor is not measured still pulls it."""
     from harvester.diagnosis.name.results import ConfirmSettings
     from harvester.diagnosis.name.limits import mark_apart
     from harvester.diagnosis.name.skips import sampling_order
-    cs = ConfirmSettings()
+    # a record that resolves 8.28 um of displacement (rel_disp, the floor at an 81.9 Hz band)
+    cs = ConfirmSettings(noise_floor=8.28e-6)
+    problem = SimpleNamespace(output_type=SimpleNamespace(order=0), band_hz=81.9)
 
-    def hysteresis(on_bound, gain=213.2):
+    def hysteresis(on_bound, gain=213.2, delta=1.08e-6):
         s = _screened("hysteresis", 222.3)
-        s.laplace_gain, s.on_bound = gain, on_bound
+        s.laplace_gain, s.on_bound, s.problem = gain, on_bound, problem
+        s.names, s.theta = ("F_hyst", "delta_hyst"), np.array([0.0129, delta])
         return s
 
     limits = {"sticking_friction": _screened("sticking_friction", 15.1),
@@ -389,6 +397,12 @@ def test_a_best_fit_on_a_limit_its_limits_fall_short_of_is_sampled_in_its_turn()
     near = {"hysteresis": hysteresis({"delta_hyst": ("lower", 40.0)}, gain=16.0), **limits}
     mark_apart(near, cs)
     assert near["hysteresis"].apart == () and near["hysteresis"].pulled
+    seen = {"hysteresis": hysteresis({"delta_hyst": ("lower", 40.0)}, delta=2e-5), **limits}
+    mark_apart(seen, cs)  # a bound above the resolution: the prior cuts what the record holds
+    assert seen["hysteresis"].apart == ()
+    unmeasured = {"hysteresis": hysteresis({"delta_hyst": ("lower", 40.0)}), **limits}
+    mark_apart(unmeasured, ConfirmSettings())
+    assert unmeasured["hysteresis"].apart == ()
 
 
 def test_laws_with_memory_are_screened_whatever_their_score():

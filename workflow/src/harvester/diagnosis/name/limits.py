@@ -47,22 +47,24 @@ def limit_candidates(effect: str, edges: Mapping[str, str], structure: ModelStru
 
 def apart_from_limits(result: CandidateResult, fitted: Mapping, settings: ConfirmSettings
                       ) -> dict[str, float]:
-    """Where the candidate stands for other terms at a bound (a pre-sliding displacement the
-    record does not resolve, or piled on its prior's lower bound: ``Term.limits``), whether
-    the record still tells it from them: each of those terms screened this round
-    (``fitted``: effect -> Screened) with a usable best fit whose evidence bound falls short
-    of the candidate's gain by more than the naming margin (log(1/alpha) + mc_sigmas of its
-    standard error). The law is then not its limit: its force, not its displacement, tells
-    it apart, and that displacement is an upper bound, not a value. Sets
-    ``result.limits_short`` (term -> bound) and, where nothing else holds it back, accepts
-    it. On the literature generator's Bouc-Wen friction as base_disp -> rel_disp (pre-sliding
-    1.7 um, the record resolving 8.3 um) hysteresis gained +212.3 nats, piled at 1.08 um,
-    its limits' best fits +15.1 (sticking) and +1.7 (Coulomb): taken as its limit, neither
-    could be named. On the frame the sticking law's best fit comes within it where the
-    bristle is a stand-in. Returns ``limits_short``."""
-    edges = {**result.at_prior_edge, **{n: "lower" for n in result.unresolved}}
-    limits = tuple(sorted({o for n, s in edges.items()
-                           for o in term(result.effect).limit_terms(n, s)}))
+    """Where the candidate stands for other terms at a displacement the record does not
+    resolve (:func:`unresolved`, ``Term.limits``: a pre-sliding displacement of nothing is
+    friction that sticks, or a sign law), whether the record still tells it from them: each
+    of those terms screened this round (``fitted``: effect -> Screened) with a usable best fit
+    whose evidence bound falls short of the candidate's gain by more than the naming margin
+    (log(1/alpha) + mc_sigmas of its standard error). The law is then not its limit: its
+    force, not its displacement, tells it apart, and that displacement is an upper bound,
+    not a value; a posterior piled against the prior's bound there (below the resolution) is
+    no reason to distrust it, a pile of any other parameter is. Sets ``result.limits_short``
+    (term -> bound) and, where nothing else holds it back, accepts it. On the literature
+    generator's Bouc-Wen friction as base_disp -> rel_disp (pre-sliding 1.7 um, the record
+    resolving 8.3 um) hysteresis gained +212.3 nats, piled at 1.08 um, its limits' best fits
+    +15.1 (sticking) and +1.7 (Coulomb): taken as its limit, neither could be named. On the
+    frame the sticking law's best fit comes within it where the bristle is a stand-in; on
+    EMPS a hysteretic spring piled on its yield displacement's bound (1.58 mm, resolved)
+    stands for the position loop and is not waived. Returns ``limits_short``."""
+    limits = tuple(sorted({o for n in result.unresolved
+                           for o in term(result.effect).limit_terms(n, "lower")}))
     least = result.delta_log_evidence - settings.base_threshold \
         - settings.mc_sigmas * result.delta_se
     if not _short(limits, fitted, least):
@@ -83,13 +85,18 @@ def mark_apart(fitted: Mapping, settings: ConfirmSettings) -> None:
     whose best fit lies on a bound where its term becomes other terms (``Term.limits``), each
     of them screened with a usable fit whose evidence bound falls short of the candidate's
     Laplace gain by more than log(1/alpha): its posterior may pile there and it is still
-    judged (:func:`apart_from_limits`), so it is sampled in its turn, not last or never."""
+    judged (:func:`apart_from_limits`), so it is sampled in its turn, not last or never. Only
+    a displacement the record must resolve (``Term.resolved``) whose best fit lies below the
+    resolution (``settings.noise_floor``; none where it is not measured)."""
     for s in fitted.values():
-        if s.failed:
+        if s.failed or settings.noise_floor is None or s.problem is None:
             continue
         least = s.laplace_gain - settings.base_threshold
+        floor = _resolution(s.problem, settings.noise_floor)
         s.apart = tuple(n for n, (side, _) in s.on_bound.items()
-                        if _short(term(s.effect).limit_terms(n, side), fitted, least))
+                        if n in term(s.effect).resolved
+                        and s.theta[s.names.index(n)] < floor
+                        and _short(term(s.effect).limit_terms(n, side), fitted, least))
 
 
 def _short(limits: tuple[str, ...], fitted: Mapping, least: float) -> bool:
@@ -107,8 +114,13 @@ def resolution(fit: ModelFit, noise_floor: float) -> float:
     displacement at the top of that band (floor / (2 pi f)^order: the displacement itself,
     or its second derivative). Below it a displacement of the model leaves nothing in the
     record but the noise."""
-    order = fit.problem.output_type.order
-    return float(noise_floor) / (2.0 * np.pi * fit.problem.band_hz) ** order
+    return _resolution(fit.problem, noise_floor)
+
+
+def _resolution(problem, noise_floor: float) -> float:
+    """:func:`resolution` on a likelihood's problem (``map_fit.ChainProblem``)."""
+    order = problem.output_type.order
+    return float(noise_floor) / (2.0 * np.pi * problem.band_hz) ** order
 
 
 def unresolved(effect: str, fit: ModelFit, noise_floor: float | None

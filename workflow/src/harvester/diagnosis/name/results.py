@@ -110,15 +110,18 @@ class CandidateResult:
     #: band's top), both Hz (``limits.beyond_band``)
     beyond_band: dict[str, tuple[float, float]] = field(default_factory=dict)
     seconds: float = 0.0  # wall time of its confirmation (TMCMC, or the estimate it rests on)
-    #: the terms it would stand for at its unresolved or piled lower limits, each screened
-    #: and short of its gain by more than the naming margin: term -> evidence bound, nats
+    #: the terms it would stand for at a displacement the record does not resolve, each
+    #: screened and short of its gain by more than the naming margin: term -> bound, nats
     #: (``limits.apart_from_limits``); the record then tells the law from them by its force
     limits_short: dict[str, float] = field(default_factory=dict)
 
     def _told(self, name: str, side: str) -> bool:
-        """Whether the record tells the term from every term it stands for at that bound."""
+        """Whether the record tells the term from every term it stands for at that bound, a
+        displacement it does not resolve (:attr:`limits_short`; a bound of another
+        parameter is never waived: there the prior cut off what the record holds)."""
         others = term(self.effect).limit_terms(name, side)
-        return bool(others) and all(o in self.limits_short for o in others)
+        return name in self.unresolved and bool(others) \
+            and all(o in self.limits_short for o in others)
 
     @property
     def at_limit(self) -> dict[str, str]:
@@ -132,7 +135,8 @@ class CandidateResult:
     @property
     def untrusted_edges(self) -> dict[str, str]:
         """Its parameters piled against a bound of the prior that leave it untrusted: all
-        but a lower limit whose terms the record tells it from (:attr:`limits_short`)."""
+        but an unresolved displacement's lower bound, lying below what the record resolves,
+        where the record tells it from its limits (:attr:`limits_short`)."""
         return {n: s for n, s in self.at_prior_edge.items() if not self._told(n, s)}
 
     @property

@@ -264,9 +264,9 @@ def limits_short_sentence(r) -> str:
     """Why a candidate whose displacement the record does not resolve, or whose posterior
     piles where it becomes its limits, still stands (``CandidateResult.limits_short``)."""
     where = [f"its {n} of {x * 1e6:.3g} um lies below the {res * 1e6:.3g} um the record "
-             "resolves" for n, (x, res) in r.unresolved.items()]
-    where += [f"the posterior of {n} piles against its prior's {side} bound"
-              for n, side in r.at_prior_edge.items() if n not in r.unresolved]
+             "resolves" + (", its posterior piled against the prior's bound there"
+                           if n in r.at_prior_edge else "")
+             for n, (x, res) in r.unresolved.items()]
     limits = ", ".join(f"{e} {b:+.1f}" for e, b in r.limits_short.items())
     return (f"{r.effect}: {'; '.join(where)}, where the law becomes {' or '.join(r.limits_short)}"
             f"; their best fits ({limits} nats at most) fall short of its "
