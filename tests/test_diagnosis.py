@@ -405,17 +405,6 @@ def test_a_best_fit_on_a_limit_its_limits_fall_short_of_is_sampled_in_its_turn()
     assert unmeasured["hysteresis"].apart == ()
 
 
-def test_laws_with_memory_are_screened_whatever_their_score():
-    """rank.unprobed_rivals: hysteresis and the hysteretic spring, whose probes can miss a
-    loop the record holds, are screened beside the ranked candidates where the structure can
-    take them and they are not listed already."""
-    from harvester.diagnosis.name.rank import unprobed_rivals
-    allowed = set(candidate_terms(()))
-    assert unprobed_rivals(["inertia_error"], allowed) == ["hysteresis", "hysteretic_spring"]
-    assert unprobed_rivals(["hysteresis"], allowed) == ["hysteretic_spring"]
-    assert unprobed_rivals([], allowed - {"hysteresis", "hysteretic_spring"}) == []
-
-
 def test_an_effect_is_named_alone_only_beyond_the_threshold_of_every_different_rival():
     from harvester.diagnosis.name.confirm import mark_ties
     from harvester.diagnosis.name.results import ConfirmSettings

@@ -172,11 +172,3 @@ def limit_rivals(effects: list[str], allowed: set[str]) -> list[str]:
                 out.append(limit)
     return out
 
-
-def unprobed_rivals(effects: list[str], allowed: set[str]) -> list[str]:
-    """The terms the score test cannot see (``Term.unprobed``: laws with memory) that the
-    structure can take (``allowed``) and that are not among ``effects``: the first round
-    screens their best fits. On the literature generator's Bouc-Wen friction as base_disp ->
-    rel_disp hysteresis scored z = 0.07 (delta_chi2 0.00) and was never fitted, while its best
-    fit gains +222 nats against the mass error's +203 that was named (December 2026)."""
-    return [e for e in sorted(allowed) if term(e).unprobed and e not in effects]

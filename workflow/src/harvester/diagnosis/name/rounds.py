@@ -27,7 +27,7 @@ from harvester.diagnosis.name.fits import ModelFit
 from harvester.diagnosis.detect.floor import problem_floor
 from harvester.diagnosis.detect.scores import Detection, detect
 from harvester.diagnosis.name.rank import (RankedCandidate, limit_rivals, rank, rivals,
-                                           to_confirm, unprobed_rivals)
+                                           to_confirm)
 from harvester.diagnosis.name.screen import Screen, screen
 from harvester.diagnosis.name.simulable import withdraw_divergent
 from harvester.diagnosis.name.sensor import SensorReading, hold_against_sensor
@@ -105,9 +105,8 @@ def run_rounds(analysis: Analysis, start: BaselineStart, settings: DiagnosisSett
             baseline_fit = baseline_fit or now.fit
         effects = [c.effect for c in chosen + rivals(rnd.ranked, chosen)]
         effects += [e for e in extra if e not in effects]
-        allowed = set(candidate_terms(now.structure.terms, settings.candidates))
-        effects += unprobed_rivals(effects, allowed) if r == 0 else []
-        effects += limit_rivals(effects, allowed)
+        effects += limit_rivals(effects, set(candidate_terms(now.structure.terms,
+                                                             settings.candidates)))
         if spent(settings):
             unexplained = unexplained or det.significant
             notes.append(cut_round(rnd, effects, r, settings))

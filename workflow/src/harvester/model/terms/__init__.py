@@ -177,10 +177,6 @@ class Term:
     to be its physics (a pre-sliding displacement): where the posterior puts one below the
     smallest displacement the record tells from its noise, the term is taken at that
     parameter's lower limit (``limits``), not named (``diagnosis.name.limits.unresolved``).
-    ``unprobed``: the score test cannot see the term (a law with memory: its probe's loop,
-    at a guessed pre-sliding displacement and a small strength, can point away from a loop
-    the record holds), so the first round screens its best fit wherever the structure can
-    take it (``diagnosis.name.rank.unprobed_rivals``).
     ``in_band``: parameters that are frequencies (Hz) of a resonance the record must show:
     where the posterior puts one above the band the likelihood compares, the record holds no
     peak of it and the term is not named (``diagnosis.name.limits.beyond_band``).
@@ -210,7 +206,6 @@ class Term:
     alike: tuple[str, ...] = ()
     limits: tuple[tuple[str, str, str], ...] = ()
     resolved: tuple[str, ...] = ()
-    unprobed: bool = False
     in_band: tuple[str, ...] = ()
     restates: tuple[str, ...] = ()
     nameable: bool = True
