@@ -18,7 +18,6 @@ from harvester.diagnosis.name.verdict import decide_verdict
 from harvester.inference.map_fit import ChainProblem, chain_problem
 from harvester.diagnosis.detect.scores import estimate_temper
 from harvester.diagnosis.name.rank import rank
-from harvester.diagnosis.detect.signatures import candidate_terms
 from harvester.diagnosis.detect.spectral import filter_cutoff
 from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
 from harvester.inference.problems import make_problem
