@@ -498,11 +498,10 @@ def judge(effect: str, fit: ModelFit, baseline: ModelFit, settings: ConfirmSetti
         log.warning("%s: not named: %s", fit.structure.name, d.sentence())
     hidden = unresolved(effect, fit, settings.noise_floor)
     above = beyond_band(effect, fit)
-    result = CandidateResult(effect, fit, float(delta), se, float(threshold),
-                             bool(delta > threshold and not edges and not hidden
-                                  and not above and not contradictions(device)),
+    result = CandidateResult(effect, fit, float(delta), se, float(threshold), False,
                              at_prior_edge=edges, device=device, unresolved=hidden,
                              beyond_band=above)
+    result.accepted = result.passes()
     if result.unshown:
         log.warning("%s: %s", fit.structure.name, result.unresolved_sentence())
     return result

@@ -70,9 +70,7 @@ def apart_from_limits(result: CandidateResult, fitted: Mapping, settings: Confir
     if not _short(limits, fitted, least):
         return {}
     result.limits_short = {o: float(fitted[o].bound) for o in limits}
-    result.accepted = bool(result.delta_log_evidence > result.threshold
-                           and not result.untrusted_edges and not result.unshown
-                           and not result.contradicted)
+    result.accepted = result.passes()
     log.info("%s: its limits' best fits (%s) fall short of its %+.1f nats: the record tells "
              "it from them", result.effect, ", ".join(f"{e} {b:+.1f}" for e, b in
                                                      result.limits_short.items()),

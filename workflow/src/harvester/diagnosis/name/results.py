@@ -159,6 +159,14 @@ class CandidateResult:
                "band's top, which a filter or a sensor makes as well: not named"
                for n, (x, b) in self.beyond_band.items()])
 
+    def passes(self) -> bool:
+        """The acceptance rule (``confirm.judge``): its gain above the threshold, and
+        nothing that holds it back: no parameter piled where the prior cut what the record
+        holds (:attr:`untrusted_edges`), no physics the record does not show
+        (:attr:`unshown`), no implied device the sidecar contradicts."""
+        return bool(self.delta_log_evidence > self.threshold and not self.untrusted_edges
+                    and not self.unshown and not self.contradicted)
+
     @property
     def contradicted(self) -> list[Implied]:
         """The implied quantities that contradict the sidecar (then it is not accepted)."""
