@@ -18,6 +18,7 @@ from harvester.diagnosis.name.verdict import decide_verdict
 from harvester.inference.map_fit import ChainProblem, chain_problem
 from harvester.diagnosis.detect.scores import estimate_temper
 from harvester.diagnosis.name.rank import rank
+from harvester.diagnosis.detect.signatures import candidate_terms
 from harvester.diagnosis.detect.spectral import filter_cutoff
 from harvester.synthetic.measured import TABLE1_KNOWN, TANH_TABLE5, measured_recording
 from harvester.inference.problems import make_problem
@@ -402,6 +403,28 @@ def test_a_best_fit_on_a_limit_its_limits_fall_short_of_is_sampled_in_its_turn()
     unmeasured = {"hysteresis": hysteresis({"delta_hyst": ("lower", 40.0)}), **limits}
     mark_apart(unmeasured, ConfirmSettings())
     assert unmeasured["hysteresis"].apart == ()
+
+
+def test_a_catch_all_leading_the_screen_has_the_laws_with_memory_fitted_before_it():
+    """rank.behind_catch_all: where a mass error or a mode leads a round's screen (the first
+    that did not fail), hysteresis and the hysteretic spring, whose probes can miss a loop the
+    record holds, are screened with the limits they stand for; not where another term leads,
+    nor twice, nor where the structure cannot take them."""
+    from harvester.diagnosis.name.rank import behind_catch_all
+    allowed = set(candidate_terms(()))
+    more = behind_catch_all(["unmodelled_mode", "inertia_error"], set(), {"unmodelled_mode",
+                            "inertia_error"}, allowed)
+    assert more[:2] == ["hysteresis", "hysteretic_spring"]
+    assert set(more[2:]) == {"sticking_friction", "coulomb_friction"} & allowed
+    assert behind_catch_all(["end_stop", "inertia_error"], {"end_stop"}, set(), allowed)[0] \
+        == "hysteresis"  # a failed fit does not lead
+    assert behind_catch_all(["stribeck_friction", "unmodelled_mode"], set(), set(),
+                            allowed) == []
+    done = {"inertia_error", "hysteresis", "hysteretic_spring", "sticking_friction",
+            "coulomb_friction"}
+    assert behind_catch_all(["inertia_error"], set(), done, allowed) == []
+    assert behind_catch_all(["inertia_error"], set(), {"inertia_error"},
+                            allowed - {"hysteresis", "hysteretic_spring"}) == []
 
 
 def test_an_effect_is_named_alone_only_beyond_the_threshold_of_every_different_rival():

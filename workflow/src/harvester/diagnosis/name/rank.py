@@ -172,3 +172,22 @@ def limit_rivals(effects: list[str], allowed: set[str]) -> list[str]:
                 out.append(limit)
     return out
 
+
+
+def behind_catch_all(order: list[str], failed: set[str], done: set[str],
+                     allowed: set[str]) -> list[str]:
+    """The terms a round's screen fits before a catch-all term that leads it is judged: where
+    the first of ``order`` (the screened effects by bound) that did not fail (``failed``) is a
+    catch-all (``Term.catch_all``: a mass error, a mode), the unprobed terms the structure can
+    take (``allowed``; ``Term.unprobed``: the laws with memory) and the limits they stand for,
+    those not in ``done`` (screened, or cut by the budget). A higher bar for the terms the
+    library's grid names where none was put in (issue 63): a mass error or a mode was named
+    where absent on 3 of 29 records each (535fb08). On the literature generator's Bouc-Wen
+    friction as base_disp -> rel_disp a mode led the screen (+249 by its bound, above the
+    band), a mass error was named (+189 nats), and hysteresis, which scored z = 0.07, gains
+    +212 when fitted."""
+    leader = next((e for e in order if e not in failed), None)
+    if leader is None or not term(leader).catch_all:
+        return []
+    more = [e for e in sorted(allowed) if term(e).unprobed and e not in done]
+    return more + [e for e in limit_rivals(more, allowed) if e not in done]

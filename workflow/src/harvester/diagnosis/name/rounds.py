@@ -26,9 +26,9 @@ from harvester.diagnosis.name.results import CandidateResult
 from harvester.diagnosis.name.fits import ModelFit
 from harvester.diagnosis.detect.floor import problem_floor
 from harvester.diagnosis.detect.scores import Detection, detect
-from harvester.diagnosis.name.rank import (RankedCandidate, limit_rivals, rank, rivals,
-                                           to_confirm)
-from harvester.diagnosis.name.screen import Screen, screen
+from harvester.diagnosis.name.rank import (RankedCandidate, behind_catch_all, limit_rivals,
+                                           rank, rivals, to_confirm)
+from harvester.diagnosis.name.screen import Screen, screen, screen_more
 from harvester.diagnosis.name.simulable import withdraw_divergent
 from harvester.diagnosis.name.sensor import SensorReading, hold_against_sensor
 from harvester.diagnosis.prepare.settings import DiagnosisSettings
@@ -135,6 +135,15 @@ def sample_round(rnd: Round, now: Current, effects: list[str], analysis: Analysi
     scale = rnd.scale = motion_scale(rnd.state, analysis.window, det.frame.f_high)
     rnd.screen = screen(now.fit, effects, now.priors, scale, det, settings.seed + r,
                         stop=lambda: spent(settings))
+    more = [] if rnd.screen.unscreened else behind_catch_all(
+        rnd.screen.order, {s.effect for s in rnd.screen.candidates if s.failed},
+        set(rnd.screen.order), set(candidate_terms(now.structure.terms, settings.candidates)))
+    if more:
+        log.info("%s leads the screen and stands for what is not fitted: %s screened before "
+                 "it is judged", rnd.screen.order[0], ", ".join(more))
+        screen_more(rnd.screen, now.fit, more, now.priors, scale, det, settings.seed + r,
+                    stop=lambda: spent(settings))
+        effects = effects + more
     rnd.unfinished += [Unfinished(f"round {r + 1}", now.fit.structure.with_term(e).name,
                                   "MAP fit stopped" if e == rnd.screen.stopped
                                   else "not screened") for e in rnd.screen.unscreened]

@@ -297,18 +297,28 @@ def screen(nested: ModelFit, effects: list[str], priors: Mapping[str, PriorSpec]
                  nested_value=max(v for _, v in fits),
                  nested_laplace=point.log_evidence_laplace)
     check_estimator(out, nested, point, seed)
+    return screen_more(out, nested, effects, priors, scale, detection, seed, stop)
+
+
+def screen_more(out: Screen, nested: ModelFit, effects: list[str],
+                priors: Mapping[str, PriorSpec], scale: DeviceScale,
+                detection: Detection | None = None, seed: int = 0,
+                stop: Callable[[], bool] | None = None) -> Screen:
+    """``effects`` screened into ``out`` (a round's ``Screen`` on ``nested``), as
+    :func:`screen` does, its candidates sorted again by bound."""
+    nested_mean = nested.samples.mean(axis=0)
     for i, effect in enumerate(effects):
         if stop is not None and stop():
-            out.unscreened = list(effects[i:])
-            log.info("not screened, the time budget is spent: %s", ", ".join(out.unscreened))
+            out.unscreened += list(effects[i:])
+            log.info("not screened, the time budget is spent: %s", ", ".join(effects[i:]))
             break
         try:
             out.candidates.append(_screen_one(nested, effect, priors, scale, detection, seed,
                                               nested_mean, out, stop))
         except FitStopped:
-            out.unscreened, out.stopped = list(effects[i:]), effect
+            out.unscreened, out.stopped = out.unscreened + list(effects[i:]), effect
             log.info("%s: its MAP fit stopped, the time budget is spent; not screened: %s",
-                     effect, ", ".join(out.unscreened))
+                     effect, ", ".join(effects[i:]))
             break
     out.candidates.sort(key=lambda s: (s.failed, -s.bound))
     log.info("screened by MAP (nested: log evidence %.1f, best log L %.1f, Laplace %.1f): %s",

@@ -180,6 +180,12 @@ class Term:
     ``in_band``: parameters that are frequencies (Hz) of a resonance the record must show:
     where the posterior puts one above the band the likelihood compares, the record holds no
     peak of it and the term is not named (``diagnosis.name.limits.beyond_band``).
+    ``unprobed``: the score test cannot see the term (a law with memory: its probe's loop, at
+    a guessed pre-sliding displacement and a small strength, can point away from a loop the
+    record holds). ``catch_all``: a term flexible enough to stand for physics the round did
+    not fit (a mass error scales the whole inertial force, a mode adds a resonance anywhere in
+    the band): a round whose screen it leads fits the ``unprobed`` terms before judging it
+    (``diagnosis.name.rank.behind_catch_all``).
     ``static`` (a ``stick`` term): its share of the holding level (N), a function of its
     parameters. ``transition`` (a ``stick`` term whose law changes fast at low speed, a
     Stribeck decay): (speed, slope) = transition(*params), the speed (m/s) below which the
@@ -207,6 +213,8 @@ class Term:
     limits: tuple[tuple[str, str, str], ...] = ()
     resolved: tuple[str, ...] = ()
     in_band: tuple[str, ...] = ()
+    unprobed: bool = False
+    catch_all: bool = False
     restates: tuple[str, ...] = ()
     nameable: bool = True
     device: Callable[[Mapping], dict] | None = None

@@ -103,6 +103,7 @@ TERM = Term(
     # at 1e-4 of the RMS displacement the law is a sign law: a posterior piled there, or a
     # pre-sliding displacement the record does not resolve, asks for dry friction: one that
     # holds (sticking_friction), or a sign law (Coulomb's)
+    unprobed=True,
     limits=(("delta_hyst", "lower", "sticking_friction"),
             ("delta_hyst", "lower", "coulomb_friction")),
     resolved=("delta_hyst",),

@@ -90,6 +90,7 @@ TERM = Term(
     description="hysteretic spring (Bouc-Wen): a loop in the restoring force",
     force=force, state_rates=state_rates, rate_bound=rate_bound, alike=("hysteresis",),
     # a yield displacement of nothing: the element holds, then slides at k_bw d_bw / (1 + e_bw)
+    unprobed=True,
     limits=(("d_bw", "lower", "sticking_friction"), ("d_bw", "lower", "coulomb_friction")),
     probe=Probe("k_bw", lambda d: 0.1 * d.k,
                 shapes=lambda d: [{"d_bw": y * d.z, "e_bw": e}

@@ -52,6 +52,9 @@ TERM = Term(
     equation="M -> M + dM, m -> m + m_share dM (eq. 2: M = m + J (2 pi / l)^2)",
     description="effective mass differs from the assumed value",
     force=force, masses=masses, rate_bound=rate_bound, device=device, restates=("M", "m"),
+    # named where none was put in on 3 of the 29 records of the new recording kinds' grid
+    # (535fb08, docs/measurements.md): a round it leads fits the laws with memory first
+    catch_all=True,
     probe=Probe("dM", lambda d: 0.008 * d.M, signed=True,
                 shapes=lambda d: [{"m_share": share} for share in (0.0, 1.0)]),
     source=__file__)
