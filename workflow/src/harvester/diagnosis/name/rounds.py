@@ -135,15 +135,7 @@ def sample_round(rnd: Round, now: Current, effects: list[str], analysis: Analysi
     scale = rnd.scale = motion_scale(rnd.state, analysis.window, det.frame.f_high)
     rnd.screen = screen(now.fit, effects, now.priors, scale, det, settings.seed + r,
                         stop=lambda: spent(settings))
-    more = [] if rnd.screen.unscreened else behind_catch_all(
-        rnd.screen.order, {s.effect for s in rnd.screen.candidates if s.failed},
-        set(rnd.screen.order), set(candidate_terms(now.structure.terms, settings.candidates)))
-    if more:
-        log.info("%s leads the screen and stands for what is not fitted: %s screened before "
-                 "it is judged", rnd.screen.order[0], ", ".join(more))
-        screen_more(rnd.screen, now.fit, more, now.priors, scale, det, settings.seed + r,
-                    stop=lambda: spent(settings))
-        effects = effects + more
+    effects, behind = screen_behind_catch_all(rnd, now, effects, scale, settings, r)
     rnd.unfinished += [Unfinished(f"round {r + 1}", now.fit.structure.with_term(e).name,
                                   "MAP fit stopped" if e == rnd.screen.stopped
                                   else "not screened") for e in rnd.screen.unscreened]
@@ -162,7 +154,29 @@ def sample_round(rnd: Round, now: Current, effects: list[str], analysis: Analysi
     notes = withdraw_divergent(rnd.confirmed, chain, confirmation)
     rnd.sensor, said = hold_against_sensor(rnd, chain, analysis.f_high, confirmation)
     rnd.seconds["confirm"] = time.perf_counter() - begun - rnd.seconds["screen"]
-    return rnd.accepted, notes + said
+    return rnd.accepted, behind + notes + said
+
+
+def screen_behind_catch_all(rnd: Round, now: Current, effects: list[str], scale,
+                            settings: DiagnosisSettings, r: int
+                            ) -> tuple[list[str], list[str]]:
+    """Where a catch-all term leads the round's screen, the laws with memory and their
+    limits fitted into it (``rank.behind_catch_all``): (the round's effects with them, a
+    note saying so, or none)."""
+    fitted = rnd.screen
+    more = [] if fitted.unscreened else behind_catch_all(
+        fitted.order, {s.effect for s in fitted.candidates if s.failed}, set(fitted.order),
+        set(candidate_terms(now.structure.terms, settings.candidates)))
+    if not more:
+        return effects, []
+    leader = fitted.order[0]
+    log.info("%s leads the screen and can stand for what is not fitted: %s screened before "
+             "it is judged", leader, ", ".join(more))
+    screen_more(fitted, now.fit, more, now.priors, scale, rnd.detection, settings.seed + r,
+                stop=lambda: spent(settings))
+    return effects + more, [f"round {r + 1}: {leader} led the screen; {', '.join(more)}, "
+                            "which the detection's scores cannot see, screened beside it "
+                            "(a catch-all term is judged against them)"]
 
 
 def cut_round(rnd: Round, effects: list[str], r: int, settings: DiagnosisSettings) -> str:
