@@ -19,10 +19,10 @@ from collections.abc import Mapping
 import numpy as np
 
 from harvester.diagnosis.detect.signatures import candidate_terms
-from harvester.diagnosis.name.screen import above_band
-from harvester.model.structures import ModelStructure
 from harvester.diagnosis.name.fits import ModelFit
 from harvester.diagnosis.name.results import CandidateResult, ConfirmSettings
+from harvester.diagnosis.name.screen import above_band
+from harvester.model.structures import ModelStructure
 from harvester.model.terms import term
 
 log = logging.getLogger("harvester.diagnosis")

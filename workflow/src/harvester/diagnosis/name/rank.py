@@ -173,7 +173,6 @@ def limit_rivals(effects: list[str], allowed: set[str]) -> list[str]:
     return out
 
 
-
 def behind_catch_all(order: list[str], failed: set[str], done: set[str],
                      allowed: set[str]) -> list[str]:
     """The terms a round's screen fits before a catch-all term that leads it is judged: where

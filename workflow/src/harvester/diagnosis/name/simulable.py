@@ -21,7 +21,6 @@ from collections.abc import Callable
 import numpy as np
 
 from harvester.diagnosis.name.confirm import mark_ties
-
 from harvester.diagnosis.name.results import CandidateResult, ConfirmSettings
 from harvester.inference.map_fit import ChainProblem
 from harvester.model.structures import ModelStructure
